@@ -1,0 +1,60 @@
+//! Rays, shapes and their intersection, written to stay right in f32 on hard
+//! cases: huge spheres used as walls, rays from far away, grazing and tangent
+//! rays, rays spawned on surfaces. Nothing here knows about materials or light.
+
+mod frame;
+mod plane;
+mod ray;
+mod sphere;
+mod triangle;
+
+pub use frame::Frame;
+pub use plane::intersect_plane;
+pub(crate) use plane::{plane_hit, plane_t};
+pub use ray::{gamma, offset_ray_origin, Ray};
+pub use sphere::intersect_sphere;
+pub(crate) use sphere::{sphere_hit, sphere_t};
+pub use triangle::{intersect_triangle, Triangle};
+
+use glam::Vec3;
+
+/// A surface point found by a ray: where, how far, which way the surface faces,
+/// and how far the computed point may be from the true surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// The hit point in world space (re-projected onto the surface where possible).
+    pub point: Vec3,
+    /// Unit geometric normal, outward for spheres, as given for planes and by the
+    /// winding (b − a) × (c − a) for triangles.
+    pub normal: Vec3,
+    /// Bound on the absolute error of `point` along any axis; ray origins spawned
+    /// here are pushed out by at least this much.
+    pub error: f32,
+}
+
+impl SurfaceHit {
+    /// A ray leaving this hit in `direction`, with its origin offset to the side
+    /// of the surface the direction points to, so it cannot re-hit the surface.
+    #[inline]
+    pub fn spawn_ray(&self, direction: Vec3) -> Ray {
+        Ray::new(
+            offset_ray_origin(self.point, self.error, self.normal, direction),
+            direction,
+        )
+    }
+
+    /// A ray from this hit toward `target`, with `t_max` just short of it, for
+    /// shadow tests; the target's own error bound keeps it off the far surface.
+    #[inline]
+    pub fn spawn_ray_to(&self, target: Vec3, target_error: f32) -> (Ray, f32) {
+        let direction = target - self.point;
+        let origin = offset_ray_origin(self.point, self.error, self.normal, direction);
+        let to_target = target - origin;
+        let distance = to_target.length();
+        let direction = to_target / distance;
+        let margin = target_error.max(ray::spawn_offset_scale(target)) * 4.0;
+        (Ray::new(origin, direction), (distance - margin).max(0.0))
+    }
+}

@@ -1,0 +1,99 @@
+use glam::Vec3;
+
+/// A ray `x(t) = origin + t·direction`, `direction` unit length, `t ≥ 0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    pub origin: Vec3,
+    pub direction: Vec3,
+}
+
+impl Ray {
+    #[inline]
+    pub fn new(origin: Vec3, direction: Vec3) -> Self {
+        Self { origin, direction }
+    }
+
+    #[inline]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.direction * t
+    }
+}
+
+/// pbrt's γ(n) = n·ε / (1 − n·ε), ε half of `f32::EPSILON`: the relative error
+/// bound of n chained f32 operations.
+#[inline]
+pub const fn gamma(n: u32) -> f32 {
+    let e = f32::EPSILON * 0.5 * n as f32;
+    e / (1.0 - e)
+}
+
+/// Offset that covers the rounding of a point of this magnitude
+/// (Wächter & Binder, Ray Tracing Gems ch. 6: 256 ulps, or a fixed floor near
+/// the origin where ulps vanish).
+#[inline]
+pub(crate) fn spawn_offset_scale(p: Vec3) -> f32 {
+    const ORIGIN: f32 = 1.0 / 32.0;
+    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
+    const INT_SCALE: f32 = 256.0;
+    let m = p.abs().max_element();
+    if m < ORIGIN {
+        FLOAT_SCALE
+    } else {
+        // ulp(m) · 256, computed from the exponent so it is exact and cheap.
+        let ulp = f32::from_bits((m.to_bits() & 0x7f80_0000).saturating_sub(23 << 23));
+        ulp * INT_SCALE
+    }
+}
+
+/// Move a point computed on a surface off it, to the side `direction` points
+/// to, by its error bound plus a magnitude-scaled margin, so a ray spawned there
+/// never finds the surface it started on. A fixed epsilon fails both ways: acne
+/// on large scenes, light leaks through thin shells on small ones.
+#[inline]
+pub fn offset_ray_origin(point: Vec3, error: f32, normal: Vec3, direction: Vec3) -> Vec3 {
+    let distance = error * normal.abs().element_sum() + spawn_offset_scale(point);
+    let offset = if direction.dot(normal) < 0.0 {
+        -normal * distance
+    } else {
+        normal * distance
+    };
+    let moved = point + offset;
+    // Round away from the point so the offset survives the addition.
+    Vec3::new(
+        next_away(moved.x, offset.x),
+        next_away(moved.y, offset.y),
+        next_away(moved.z, offset.z),
+    )
+}
+
+#[inline]
+fn next_away(v: f32, offset: f32) -> f32 {
+    if offset > 0.0 {
+        v.next_up()
+    } else if offset < 0.0 {
+        v.next_down()
+    } else {
+        v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offset_scale_grows_with_magnitude() {
+        let small = spawn_offset_scale(Vec3::splat(1.0));
+        let large = spawn_offset_scale(Vec3::splat(1.0e6));
+        assert!(large > small * 1.0e5);
+        assert_eq!(spawn_offset_scale(Vec3::ZERO), 1.0 / 65536.0);
+    }
+
+    #[test]
+    fn offset_goes_to_the_side_of_the_direction() {
+        let n = Vec3::Y;
+        let p = Vec3::new(3.0, 0.0, -2.0);
+        assert!(offset_ray_origin(p, 0.0, n, Vec3::Y).y > 0.0);
+        assert!(offset_ray_origin(p, 0.0, n, -Vec3::Y).y < 0.0);
+    }
+}

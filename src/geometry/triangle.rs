@@ -1,0 +1,198 @@
+use glam::{DVec3, Vec3};
+
+use super::{gamma, Ray, SurfaceHit};
+
+/// A triangle with its geometric normal precomputed; a degenerate one (zero
+/// area) has a zero normal and is never hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    pub vertices: [Vec3; 3],
+    pub normal: Vec3,
+}
+
+impl Triangle {
+    pub fn new(a: Vec3, b: Vec3, c: Vec3) -> Self {
+        // Normal in f64 so thin but valid triangles far from the origin keep one
+        let n = (b.as_dvec3() - a.as_dvec3()).cross(c.as_dvec3() - a.as_dvec3());
+        let length = n.length();
+        let normal = if length > 0.0 && length.is_finite() {
+            (n / length).as_vec3()
+        } else {
+            Vec3::ZERO
+        };
+        Self {
+            vertices: [a, b, c],
+            normal,
+        }
+    }
+
+    pub fn is_degenerate(&self) -> bool {
+        self.normal == Vec3::ZERO
+    }
+
+    pub fn area(&self) -> f32 {
+        let [a, b, c] = self.vertices;
+        0.5 * (b - a).cross(c - a).length()
+    }
+}
+
+/// Watertight ray–triangle intersection (Woop, Benthin, Wald 2013, as in
+/// pbrt-v4): shear the triangle into the ray's space so that rays through
+/// shared edges and vertices hit exactly one side or both, never neither.
+#[inline]
+pub fn intersect_triangle(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<SurfaceHit> {
+    if triangle.is_degenerate() {
+        return None;
+    }
+    let [p0, p1, p2] = triangle.vertices;
+    // Translate vertices to the ray origin, permute so z is the largest axis of d
+    let d = ray.direction;
+    let kz = d.abs().max_position();
+    let kx = if kz == 2 { 0 } else { kz + 1 };
+    let ky = if kx == 2 { 0 } else { kx + 1 };
+    let permute = |v: Vec3| Vec3::new(v[kx], v[ky], v[kz]);
+    let d = permute(d);
+    let mut p0t = permute(p0 - ray.origin);
+    let mut p1t = permute(p1 - ray.origin);
+    let mut p2t = permute(p2 - ray.origin);
+    // Shear so the ray points along +z
+    let sz = 1.0 / d.z;
+    let sx = -d.x * sz;
+    let sy = -d.y * sz;
+    for p in [&mut p0t, &mut p1t, &mut p2t] {
+        p.x += sx * p.z;
+        p.y += sy * p.z;
+    }
+    // Edge functions, redone in f64 when one is exactly zero (the edge case)
+    let mut e0 = p1t.x * p2t.y - p1t.y * p2t.x;
+    let mut e1 = p2t.x * p0t.y - p2t.y * p0t.x;
+    let mut e2 = p0t.x * p1t.y - p0t.y * p1t.x;
+    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+        let (a, b, c) = (p0t.as_dvec3(), p1t.as_dvec3(), p2t.as_dvec3());
+        let edge = |u: DVec3, v: DVec3| (u.x * v.y - u.y * v.x) as f32;
+        e0 = edge(b, c);
+        e1 = edge(c, a);
+        e2 = edge(a, b);
+    }
+    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+        return None;
+    }
+    let det = e0 + e1 + e2;
+    if det == 0.0 {
+        return None;
+    }
+    // Scaled distance, tested against the range before dividing
+    p0t.z *= sz;
+    p1t.z *= sz;
+    p2t.z *= sz;
+    let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
+    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+        return None;
+    }
+    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let (b0, b1, b2) = (e0 * inv_det, e1 * inv_det, e2 * inv_det);
+    let t = t_scaled * inv_det;
+    // Conservatively reject t too close to zero to be trusted (pbrt's δt)
+    let max_zt = Vec3::new(p0t.z, p1t.z, p2t.z).abs().max_element();
+    let delta_z = gamma(3) * max_zt;
+    let max_xt = Vec3::new(p0t.x, p1t.x, p2t.x).abs().max_element();
+    let max_yt = Vec3::new(p0t.y, p1t.y, p2t.y).abs().max_element();
+    let delta_x = gamma(5) * (max_xt + max_zt);
+    let delta_y = gamma(5) * (max_yt + max_zt);
+    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = Vec3::new(e0, e1, e2).abs().max_element();
+    let delta_t =
+        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    if t <= delta_t || !t.is_finite() {
+        return None;
+    }
+    let weighted = [p0 * b0, p1 * b1, p2 * b2];
+    let point = weighted[0] + weighted[1] + weighted[2];
+    let error =
+        gamma(7) * (weighted[0].abs() + weighted[1].abs() + weighted[2].abs()).max_element();
+    Some(SurfaceHit {
+        t,
+        point,
+        normal: triangle.normal,
+        error,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hits_inside_and_misses_outside() {
+        let tri = Triangle::new(
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        );
+        let hit = intersect_triangle(
+            &Ray::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::Z),
+            &tri,
+            f32::INFINITY,
+        )
+        .unwrap();
+        assert!((hit.t - 2.0).abs() < 1e-6);
+        assert_eq!(hit.normal, Vec3::Z);
+        assert!(intersect_triangle(
+            &Ray::new(Vec3::new(2.0, 0.0, 2.0), -Vec3::Z),
+            &tri,
+            f32::INFINITY
+        )
+        .is_none());
+        assert!(
+            intersect_triangle(&Ray::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::Z), &tri, 1.0).is_none()
+        );
+    }
+
+    #[test]
+    fn degenerate_triangles_never_hit() {
+        let collinear = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
+        let point = Triangle::new(Vec3::ONE, Vec3::ONE, Vec3::ONE);
+        let far = Triangle::new(
+            Vec3::splat(1e7),
+            Vec3::splat(1e7) + Vec3::X,
+            Vec3::splat(1e7) + Vec3::X * 2.0,
+        );
+        for tri in [collinear, point, far] {
+            assert!(tri.is_degenerate());
+            for dir in [
+                Vec3::Z,
+                -Vec3::Z,
+                Vec3::X,
+                Vec3::new(0.3, 0.4, -0.5).normalize(),
+            ] {
+                let ray = Ray::new(Vec3::new(0.5, 0.0, 1.0), dir);
+                assert!(intersect_triangle(&ray, &tri, f32::INFINITY).is_none());
+            }
+        }
+    }
+
+    #[test]
+    fn shared_edge_is_hit_by_at_least_one_triangle() {
+        let a = Vec3::new(-1.0, -1.0, 0.0);
+        let b = Vec3::new(1.0, -1.0, 0.0);
+        let c = Vec3::new(1.0, 1.0, 0.0);
+        let d = Vec3::new(-1.0, 1.0, 0.0);
+        let (t0, t1) = (Triangle::new(a, b, c), Triangle::new(a, c, d));
+        for i in 0..1000 {
+            // Interior of the shared diagonal (its ends are the square's corners)
+            let s = i as f32 / 999.0 * 1.98 - 0.99;
+            let ray = Ray::new(
+                Vec3::new(s, s, 1.0) + Vec3::new(0.1, -0.2, 0.0),
+                Vec3::new(-0.1, 0.2, -1.0).normalize(),
+            );
+            let hits = [&t0, &t1]
+                .iter()
+                .filter(|t| intersect_triangle(&ray, t, f32::INFINITY).is_some())
+                .count();
+            assert!(hits >= 1, "ray {i} fell through the diagonal");
+        }
+    }
+}

@@ -1,0 +1,9 @@
+//! GI Studio: global illumination with four light-transport algorithms on one
+//! engine. Layers depend one way: geometry → scene → render → analysis →
+//! (cli | app).
+#![forbid(unsafe_code)]
+
+pub mod cli;
+pub mod geometry;
+pub mod render;
+pub mod scene;

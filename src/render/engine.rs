@@ -1,0 +1,468 @@
+//! The progressive engine: passes over tiles in parallel, each finished tile
+//! sent at once, stopped by a generation counter that every tile checks, so a
+//! restart never waits for a pass to end. The studio and the CLI both drive it
+//! through a `RenderSession`.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use crossbeam_channel::{Receiver, Sender};
+use glam::Vec2;
+use rayon::prelude::*;
+
+use super::camera::CameraModel;
+use super::image::LinearImage;
+use super::rng::Sampler;
+use super::settings::{Algorithm, RenderSettings};
+use super::tiles::{tile_layout, TileAccumulator, TileRect};
+use super::world::World;
+use super::{path, whitted, Counters};
+use crate::scene::{Rgb, Scene};
+
+/// A scene snapshot and how to render it.
+#[derive(Clone, Debug)]
+pub struct RenderJob {
+    pub scene: Arc<Scene>,
+    pub settings: RenderSettings,
+}
+
+/// Totals after a pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PassStats {
+    /// Passes completed (= samples per pixel for Whitted and path tracing).
+    pub passes: u32,
+    pub elapsed: Duration,
+    pub pass_time: Duration,
+    /// Camera samples traced so far.
+    pub samples: u64,
+    pub rays: u64,
+    /// Samples that came out NaN or infinite and were dropped.
+    pub non_finite: u64,
+}
+
+impl PassStats {
+    pub fn samples_per_second(&self) -> f64 {
+        self.samples as f64 / self.elapsed.as_secs_f64().max(1e-9)
+    }
+
+    pub fn rays_per_second(&self) -> f64 {
+        self.rays as f64 / self.elapsed.as_secs_f64().max(1e-9)
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct TileUpdate {
+    pub generation: u64,
+    pub rect: TileRect,
+    /// Mean linear radiance, row-major within the tile.
+    pub pixels: Vec<[f32; 3]>,
+    /// A coarse block-filled preview, not yet part of the estimate.
+    pub preview: bool,
+}
+
+/// What the engine tells its driver. Every event names the generation (the
+/// job) it belongs to, so stale ones can be dropped.
+#[derive(Clone, Debug)]
+pub enum RenderEvent {
+    Started {
+        generation: u64,
+        width: u32,
+        height: u32,
+    },
+    Tile(TileUpdate),
+    PassFinished {
+        generation: u64,
+        stats: PassStats,
+    },
+    Finished {
+        generation: u64,
+        image: Arc<LinearImage>,
+        stats: PassStats,
+    },
+    Failed {
+        generation: u64,
+        message: String,
+    },
+}
+
+impl RenderEvent {
+    pub fn generation(&self) -> u64 {
+        match self {
+            RenderEvent::Started { generation, .. }
+            | RenderEvent::PassFinished { generation, .. }
+            | RenderEvent::Finished { generation, .. }
+            | RenderEvent::Failed { generation, .. } => *generation,
+            RenderEvent::Tile(tile) => tile.generation,
+        }
+    }
+}
+
+enum Command {
+    Start(u64, RenderJob),
+    Shutdown,
+}
+
+/// Called after events are sent (the studio passes `ctx.request_repaint`).
+pub type Notify = Arc<dyn Fn() + Send + Sync>;
+
+/// Handle to a background render worker: start (or restart) with a new scene
+/// snapshot, cancel, and read events. Never blocks the caller.
+pub struct RenderSession {
+    commands: Sender<Command>,
+    events: Receiver<RenderEvent>,
+    generation: Arc<AtomicU64>,
+    worker: Option<JoinHandle<()>>,
+}
+
+impl Default for RenderSession {
+    fn default() -> Self {
+        Self::new(None)
+    }
+}
+
+impl RenderSession {
+    pub fn new(notify: Option<Notify>) -> Self {
+        let (commands, command_rx) = crossbeam_channel::unbounded();
+        let (event_tx, events) = crossbeam_channel::unbounded();
+        let generation = Arc::new(AtomicU64::new(0));
+        let worker_generation = generation.clone();
+        let worker = std::thread::Builder::new()
+            .name("render-worker".into())
+            .spawn(move || worker_loop(command_rx, event_tx, worker_generation, notify))
+            .ok();
+        Self {
+            commands,
+            events,
+            generation,
+            worker,
+        }
+    }
+
+    /// Start rendering `job`, abandoning whatever was in flight. Returns the
+    /// new generation; events of older ones may still arrive and should be dropped.
+    pub fn start(&self, job: RenderJob) -> u64 {
+        let generation = self.generation.fetch_add(1, Ordering::SeqCst) + 1;
+        let _ = self.commands.send(Command::Start(generation, job));
+        generation
+    }
+
+    /// Stop the current job; the worker goes idle.
+    pub fn cancel(&self) {
+        self.generation.fetch_add(1, Ordering::SeqCst);
+    }
+
+    pub fn generation(&self) -> u64 {
+        self.generation.load(Ordering::SeqCst)
+    }
+
+    pub fn events(&self) -> &Receiver<RenderEvent> {
+        &self.events
+    }
+}
+
+impl Drop for RenderSession {
+    fn drop(&mut self) {
+        self.cancel();
+        let _ = self.commands.send(Command::Shutdown);
+        if let Some(worker) = self.worker.take() {
+            let _ = worker.join();
+        }
+    }
+}
+
+fn worker_loop(
+    commands: Receiver<Command>,
+    events: Sender<RenderEvent>,
+    generation: Arc<AtomicU64>,
+    notify: Option<Notify>,
+) {
+    let mut pools: Option<(usize, rayon::ThreadPool)> = None;
+    while let Ok(mut command) = commands.recv() {
+        // Only the newest queued job matters
+        while let Ok(newer) = commands.try_recv() {
+            command = newer;
+        }
+        let Command::Start(job_generation, job) = command else {
+            return;
+        };
+        if generation.load(Ordering::SeqCst) != job_generation {
+            continue;
+        }
+        let threads = job.settings.threads;
+        if pools.as_ref().is_none_or(|(n, _)| *n != threads) {
+            match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+                Ok(pool) => pools = Some((threads, pool)),
+                Err(e) => {
+                    let _ = events.send(RenderEvent::Failed {
+                        generation: job_generation,
+                        message: e.to_string(),
+                    });
+                    continue;
+                }
+            }
+        }
+        if let Some((_, pool)) = &pools {
+            let context = JobContext {
+                generation: job_generation,
+                current: &generation,
+                events: &events,
+                notify: notify.as_ref(),
+            };
+            pool.install(|| run_job(&context, &job));
+        }
+    }
+}
+
+struct JobContext<'a> {
+    generation: u64,
+    current: &'a AtomicU64,
+    events: &'a Sender<RenderEvent>,
+    notify: Option<&'a Notify>,
+}
+
+impl JobContext<'_> {
+    fn is_current(&self) -> bool {
+        self.current.load(Ordering::Relaxed) == self.generation
+    }
+
+    fn send(&self, event: RenderEvent) {
+        let _ = self.events.send(event);
+        if let Some(notify) = self.notify {
+            notify();
+        }
+    }
+}
+
+/// Sample index used for the coarse preview, outside any real pass's range.
+const PREVIEW_SAMPLE: u64 = u64::MAX;
+const PREVIEW_BLOCK: u32 = 8;
+
+fn run_job(context: &JobContext, job: &RenderJob) {
+    let settings = &job.settings;
+    let generation = context.generation;
+    if let Some(problem) = job.scene.validate().into_iter().next() {
+        context.send(RenderEvent::Failed {
+            generation,
+            message: problem.to_string(),
+        });
+        return;
+    }
+    if settings.width == 0 || settings.height == 0 {
+        context.send(RenderEvent::Failed {
+            generation,
+            message: "image size must be at least 1×1".into(),
+        });
+        return;
+    }
+    let frame = FrameContext {
+        world: World::new(&job.scene),
+        camera: CameraModel::new(&job.scene.camera, settings.width, settings.height),
+        settings,
+    };
+    context.send(RenderEvent::Started {
+        generation,
+        width: settings.width,
+        height: settings.height,
+    });
+    let start = Instant::now();
+    let tiles = tile_layout(settings.width, settings.height, settings.tile_size);
+
+    if settings.preview {
+        tiles.par_iter().for_each(|rect| {
+            if context.is_current() {
+                let pixels = frame.preview_tile(*rect);
+                context.send(RenderEvent::Tile(TileUpdate {
+                    generation,
+                    rect: *rect,
+                    pixels,
+                    preview: true,
+                }));
+            }
+        });
+    }
+
+    let mut buffers: Vec<TileAccumulator> =
+        tiles.iter().map(|r| TileAccumulator::new(*r)).collect();
+    let rays = AtomicU64::new(0);
+    let non_finite = AtomicU64::new(0);
+    let mut stats = PassStats::default();
+    loop {
+        let done_spp = settings
+            .samples_per_pixel
+            .is_some_and(|spp| stats.passes >= spp);
+        let done_time = settings
+            .time_limit
+            .is_some_and(|limit| stats.passes > 0 && start.elapsed().as_secs_f64() >= limit);
+        if done_spp || done_time {
+            break;
+        }
+        let pass_start = Instant::now();
+        let pass = stats.passes;
+        buffers.par_iter_mut().for_each(|buffer| {
+            if !context.is_current() {
+                return;
+            }
+            let mut counters = Counters::default();
+            frame.render_tile_pass(buffer, pass, &mut counters);
+            rays.fetch_add(counters.rays, Ordering::Relaxed);
+            non_finite.fetch_add(counters.non_finite, Ordering::Relaxed);
+            let pixels = buffer.mean();
+            context.send(RenderEvent::Tile(TileUpdate {
+                generation,
+                rect: buffer.rect,
+                pixels,
+                preview: false,
+            }));
+        });
+        if !context.is_current() {
+            return;
+        }
+        stats.passes += 1;
+        stats.samples += settings.width as u64 * settings.height as u64;
+        stats.rays = rays.load(Ordering::Relaxed);
+        stats.non_finite = non_finite.load(Ordering::Relaxed);
+        stats.pass_time = pass_start.elapsed();
+        stats.elapsed = start.elapsed();
+        context.send(RenderEvent::PassFinished { generation, stats });
+    }
+    let image = assemble(settings.width, settings.height, &buffers);
+    context.send(RenderEvent::Finished {
+        generation,
+        image: Arc::new(image),
+        stats,
+    });
+}
+
+fn assemble(width: u32, height: u32, buffers: &[TileAccumulator]) -> LinearImage {
+    let mut image = LinearImage::new(width, height);
+    for buffer in buffers {
+        let rect = buffer.rect;
+        for (i, pixel) in buffer.mean().into_iter().enumerate() {
+            let (x, y) = (
+                rect.x + i as u32 % rect.width,
+                rect.y + i as u32 / rect.width,
+            );
+            image.pixels[(y * width + x) as usize] = pixel;
+        }
+    }
+    image
+}
+
+/// Everything a pass reads: shared, immutable, built once per job.
+struct FrameContext<'a> {
+    world: World,
+    camera: CameraModel,
+    settings: &'a RenderSettings,
+}
+
+impl FrameContext<'_> {
+    /// One camera sample of pixel (x, y): jittered within the pixel, the
+    /// stream fixed by (pixel, sample, seed).
+    fn sample(&self, x: u32, y: u32, sample: u64, counters: &mut Counters) -> Option<Rgb> {
+        let settings = self.settings;
+        let pixel = y as u64 * settings.width as u64 + x as u64;
+        let mut sampler = Sampler::new(pixel, sample, settings.seed);
+        let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+        let ray = self.camera.generate_ray(film, sampler.next_2d());
+        let value = match settings.algorithm {
+            Algorithm::Whitted => whitted::radiance(
+                &self.world,
+                &ray,
+                settings.max_depth.max(1),
+                1.0,
+                &mut sampler,
+                counters,
+            ),
+            Algorithm::Path | Algorithm::Photon | Algorithm::Sppm => path::radiance(
+                &self.world,
+                &ray,
+                settings.max_depth,
+                &mut sampler,
+                counters,
+            ),
+        };
+        if !value.is_finite() {
+            counters.non_finite += 1;
+            return None;
+        }
+        let value = value.max(Rgb::ZERO);
+        Some(if settings.firefly_clamp > 0.0 {
+            value.min(Rgb::splat(settings.firefly_clamp))
+        } else {
+            value
+        })
+    }
+
+    fn render_tile_pass(&self, buffer: &mut TileAccumulator, pass: u32, counters: &mut Counters) {
+        let rect = buffer.rect;
+        for row in 0..rect.height {
+            for column in 0..rect.width {
+                let value = self
+                    .sample(rect.x + column, rect.y + row, pass as u64, counters)
+                    .unwrap_or(Rgb::ZERO);
+                let sum = &mut buffer.sums[(row * rect.width + column) as usize];
+                for c in 0..3 {
+                    sum[c] += value[c] as f64;
+                }
+            }
+        }
+        buffer.samples += 1;
+    }
+
+    /// One sample per block, copied over the block.
+    fn preview_tile(&self, rect: TileRect) -> Vec<[f32; 3]> {
+        let mut pixels = vec![[0.0; 3]; (rect.width * rect.height) as usize];
+        let mut counters = Counters::default();
+        for by in (0..rect.height).step_by(PREVIEW_BLOCK as usize) {
+            for bx in (0..rect.width).step_by(PREVIEW_BLOCK as usize) {
+                let (w, h) = (
+                    PREVIEW_BLOCK.min(rect.width - bx),
+                    PREVIEW_BLOCK.min(rect.height - by),
+                );
+                let value = self
+                    .sample(
+                        rect.x + bx + w / 2,
+                        rect.y + by + h / 2,
+                        PREVIEW_SAMPLE,
+                        &mut counters,
+                    )
+                    .unwrap_or(Rgb::ZERO);
+                for y in by..by + h {
+                    for x in bx..bx + w {
+                        pixels[(y * rect.width + x) as usize] = value.to_array();
+                    }
+                }
+            }
+        }
+        pixels
+    }
+}
+
+/// Render a job to completion on the calling thread's pool, for tests and
+/// tools that want just the image. `events` receives progress if given.
+pub fn render_blocking(job: &RenderJob) -> Result<(LinearImage, PassStats), String> {
+    let session = RenderSession::new(None);
+    let generation = session.start(job.clone());
+    for event in session.events().iter() {
+        match event {
+            RenderEvent::Finished {
+                generation: g,
+                image,
+                stats,
+            } if g == generation => {
+                return Ok((
+                    Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone()),
+                    stats,
+                ));
+            }
+            RenderEvent::Failed {
+                generation: g,
+                message,
+            } if g == generation => return Err(message),
+            _ => {}
+        }
+    }
+    Err("the render worker stopped".into())
+}

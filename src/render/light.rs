@@ -1,0 +1,255 @@
+//! Light sources as the renderer samples them: delta lights (point, spot,
+//! directional) and emissive spheres and triangles (area lights).
+
+use glam::{Vec2, Vec3};
+
+use super::sampling::{uniform_cone, uniform_cone_pdf, uniform_triangle};
+use super::world::{ShapeRef, World};
+use crate::geometry::{Frame, Ray, SurfaceHit};
+use crate::scene::{Attenuation, Rgb};
+
+#[derive(Clone, Debug)]
+pub enum LightSource {
+    Point {
+        position: Vec3,
+        intensity: Rgb,
+        attenuation: Attenuation,
+    },
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        cos_cone: f32,
+        exponent: f32,
+        intensity: Rgb,
+        attenuation: Attenuation,
+    },
+    /// `direction` is the way the light travels.
+    Directional {
+        direction: Vec3,
+        irradiance: Rgb,
+    },
+    Area {
+        object: u32,
+        radiance: Rgb,
+    },
+}
+
+/// One sampled light path segment from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the shading point toward the light.
+    pub wi: Vec3,
+    /// Irradiance at normal incidence for delta lights; radiance over the
+    /// solid-angle pdf for area lights. Either way: multiply by f·|cos θ|.
+    pub value: Rgb,
+    /// Solid-angle pdf (for MIS), infinite for delta lights.
+    pub pdf: f32,
+    /// The shadow ray and how far it may go.
+    pub shadow: Ray,
+    pub shadow_t_max: f32,
+}
+
+/// The thesis' spot factor: 0 outside the cone, (Vp·Va)^σ inside.
+#[inline]
+pub fn spot_factor(axis: Vec3, light_to_point: Vec3, cos_cone: f32, exponent: f32) -> f32 {
+    let cos = axis.dot(light_to_point);
+    if cos < cos_cone {
+        0.0
+    } else if exponent == 0.0 {
+        1.0
+    } else {
+        cos.powf(exponent)
+    }
+}
+
+impl LightSource {
+    pub fn is_delta(&self) -> bool {
+        !matches!(self, LightSource::Area { .. })
+    }
+
+    /// Sample light arriving at `at` (a surface hit, for its offset origin).
+    #[inline]
+    pub fn sample(&self, world: &World, at: &SurfaceHit, u: Vec2) -> Option<LightSample> {
+        let p = at.point;
+        match *self {
+            LightSource::Point {
+                position,
+                intensity,
+                attenuation,
+            } => {
+                let (shadow, shadow_t_max) = at.spawn_ray_to(position, 0.0);
+                let d = (position - p).length();
+                let value = intensity * attenuation.factor(d);
+                Some(LightSample {
+                    wi: shadow.direction,
+                    value,
+                    pdf: f32::INFINITY,
+                    shadow,
+                    shadow_t_max,
+                })
+            }
+            LightSource::Spot {
+                position,
+                direction,
+                cos_cone,
+                exponent,
+                intensity,
+                attenuation,
+            } => {
+                let (shadow, shadow_t_max) = at.spawn_ray_to(position, 0.0);
+                let d = (position - p).length();
+                let factor = spot_factor(direction, -shadow.direction, cos_cone, exponent);
+                if factor == 0.0 {
+                    return None;
+                }
+                let value = intensity * (attenuation.factor(d) * factor);
+                Some(LightSample {
+                    wi: shadow.direction,
+                    value,
+                    pdf: f32::INFINITY,
+                    shadow,
+                    shadow_t_max,
+                })
+            }
+            LightSource::Directional {
+                direction,
+                irradiance,
+            } => {
+                let shadow = at.spawn_ray(-direction);
+                Some(LightSample {
+                    wi: -direction,
+                    value: irradiance,
+                    pdf: f32::INFINITY,
+                    shadow,
+                    shadow_t_max: f32::INFINITY,
+                })
+            }
+            LightSource::Area { object, radiance } => {
+                let (target, normal, error, pdf) = sample_area(world, object, p, u)?;
+                let (shadow, shadow_t_max) = at.spawn_ray_to(target, error);
+                // Emission is one-sided: the light's front must face the point
+                if normal.dot(-shadow.direction) <= 0.0 || !(pdf > 0.0) {
+                    return None;
+                }
+                Some(LightSample {
+                    wi: shadow.direction,
+                    value: radiance / pdf,
+                    pdf,
+                    shadow,
+                    shadow_t_max,
+                })
+            }
+        }
+    }
+}
+
+/// A point on an area light seen from `p`: (point, outward normal, error
+/// bound, solid-angle pdf at `p`). Spheres seen from outside are sampled by
+/// the cone they subtend (every sample can be visible); triangles by area.
+#[inline]
+fn sample_area(world: &World, object: u32, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32, f32)> {
+    match world.objects[object as usize].shape {
+        ShapeRef::Sphere(i) => {
+            let i = i as usize;
+            let (center, radius) = (world.spheres.center(i), world.spheres.radius[i]);
+            let to_center = center - p;
+            let distance2 = to_center.length_squared();
+            let sin2_max = radius * radius / distance2;
+            if sin2_max >= 1.0 {
+                // Inside the sphere: its outside-facing emission is invisible
+                return None;
+            }
+            let one_minus_cos = sin2_max / (1.0 + (1.0 - sin2_max).sqrt());
+            let axis = to_center / distance2.sqrt();
+            let direction = Frame::from_z(axis).to_world(uniform_cone(u, one_minus_cos));
+            // The cone's edge rays may miss by rounding: take the closest approach
+            let ray = Ray::new(p, direction);
+            let hit = match crate::geometry::intersect_sphere(&ray, center, radius, f32::INFINITY) {
+                Some(hit) => hit,
+                None => {
+                    let t = to_center.dot(direction);
+                    crate::geometry::SurfaceHit {
+                        t,
+                        point: center + (ray.at(t) - center).normalize() * radius,
+                        normal: (ray.at(t) - center).normalize(),
+                        error: crate::geometry::gamma(6) * (center.abs().max_element() + radius),
+                    }
+                }
+            };
+            Some((
+                hit.point,
+                hit.normal,
+                hit.error,
+                uniform_cone_pdf(one_minus_cos),
+            ))
+        }
+        ShapeRef::Triangle(t) => {
+            let triangle = &world.triangles[t as usize].0;
+            let (b0, b1) = uniform_triangle(u);
+            let [a, b, c] = triangle.vertices;
+            let point = a * b0 + b * b1 + c * (1.0 - b0 - b1);
+            let to_light = point - p;
+            let distance2 = to_light.length_squared();
+            let cos_light = triangle.normal.dot(-to_light) / distance2.sqrt();
+            if cos_light <= 0.0 {
+                return None;
+            }
+            let error = crate::geometry::gamma(7) * (a.abs() + b.abs() + c.abs()).max_element();
+            Some((
+                point,
+                triangle.normal,
+                error,
+                distance2 / (cos_light * triangle.area()),
+            ))
+        }
+        ShapeRef::Plane(_) => None,
+    }
+}
+
+/// Solid-angle pdf with which `sample` would have chosen the point `hit` on
+/// area light `object` from `p` (for MIS on BSDF-sampled hits).
+#[inline]
+pub fn area_pdf(world: &World, object: u32, p: Vec3, hit: &SurfaceHit) -> f32 {
+    match world.objects[object as usize].shape {
+        ShapeRef::Sphere(i) => {
+            let i = i as usize;
+            let radius = world.spheres.radius[i];
+            let distance2 = (world.spheres.center(i) - p).length_squared();
+            let sin2_max = radius * radius / distance2;
+            if sin2_max >= 1.0 {
+                return 0.0;
+            }
+            uniform_cone_pdf(sin2_max / (1.0 + (1.0 - sin2_max).sqrt()))
+        }
+        ShapeRef::Triangle(t) => {
+            let triangle = &world.triangles[t as usize].0;
+            let to_light = hit.point - p;
+            let distance2 = to_light.length_squared();
+            let cos_light = triangle.normal.dot(-to_light).abs() / distance2.sqrt();
+            if cos_light <= 0.0 {
+                return 0.0;
+            }
+            distance2 / (cos_light * triangle.area())
+        }
+        ShapeRef::Plane(_) => 0.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spot_cone_edge_is_where_cos_says() {
+        let axis = -Vec3::Y;
+        let cone = 30.0f32.to_radians();
+        let inside = Vec3::new((cone - 1e-3).sin(), -(cone - 1e-3).cos(), 0.0);
+        let outside = Vec3::new((cone + 1e-3).sin(), -(cone + 1e-3).cos(), 0.0);
+        assert!(spot_factor(axis, inside, cone.cos(), 0.0) == 1.0);
+        assert!(spot_factor(axis, outside, cone.cos(), 0.0) == 0.0);
+        assert!(
+            (spot_factor(axis, inside, cone.cos(), 2.0) - (cone - 1e-3).cos().powi(2)).abs() < 1e-6
+        );
+        assert_eq!(spot_factor(axis, axis, 1.0, 1.0e4), 1.0);
+    }
+}

@@ -1,0 +1,131 @@
+//! Warps from the unit square to directions and points, with their pdfs.
+
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
+
+use glam::{Vec2, Vec3};
+
+/// Shirley–Chiu concentric map: low distortion, so stratification survives.
+#[inline]
+pub fn concentric_disk(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o == Vec2::ZERO {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, FRAC_PI_4 * (o.y / o.x))
+    } else {
+        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
+    };
+    r * Vec2::new(theta.cos(), theta.sin())
+}
+
+/// Cosine-weighted direction about +z; pdf = cos θ / π.
+#[inline]
+pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = concentric_disk(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+#[inline]
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    cos_theta.max(0.0) * FRAC_1_PI
+}
+
+/// Uniform direction on the unit sphere; pdf = 1 / 4π.
+#[inline]
+pub fn uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Uniform direction in a cone about +z, given `1 − cos θmax` (passed as
+/// such because it cancels to nothing in f32 for small, distant lights);
+/// pdf = 1 / (2π(1 − cos θmax)).
+#[inline]
+pub fn uniform_cone(u: Vec2, one_minus_cos_max: f32) -> Vec3 {
+    let one_minus_cos = u.x * one_minus_cos_max;
+    let cos_theta = 1.0 - one_minus_cos;
+    let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+#[inline]
+pub fn uniform_cone_pdf(one_minus_cos_max: f32) -> f32 {
+    1.0 / (2.0 * PI * one_minus_cos_max)
+}
+
+/// Direction about +z with pdf ∝ cosⁿθ: pdf = (n + 1)/(2π) · cosⁿθ.
+#[inline]
+pub fn power_cosine(u: Vec2, exponent: f32) -> Vec3 {
+    let cos_theta = u.x.powf(1.0 / (exponent + 1.0));
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+#[inline]
+pub fn power_cosine_pdf(cos_theta: f32, exponent: f32) -> f32 {
+    if cos_theta <= 0.0 {
+        0.0
+    } else {
+        (exponent + 1.0) * 0.5 * FRAC_1_PI * cos_theta.powf(exponent)
+    }
+}
+
+/// Uniform barycentrics (b0, b1) on a triangle (b2 = 1 − b0 − b1).
+#[inline]
+pub fn uniform_triangle(u: Vec2) -> (f32, f32) {
+    let su = u.x.sqrt();
+    (1.0 - su, u.y * su)
+}
+
+/// Veach's power heuristic with β = 2.
+#[inline]
+pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
+    let (f, g) = (pdf_f * pdf_f, pdf_g * pdf_g);
+    if f + g == 0.0 || !f.is_finite() {
+        return if pdf_f.is_infinite() { 1.0 } else { 0.0 };
+    }
+    f / (f + g)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::rng::Sampler;
+
+    #[test]
+    fn warps_land_where_they_should() {
+        let mut s = Sampler::new(0, 0, 9);
+        for _ in 0..10_000 {
+            let u = s.next_2d();
+            let c = cosine_hemisphere(u);
+            assert!((c.length() - 1.0).abs() < 1e-5 && c.z >= 0.0);
+            assert!((uniform_sphere(u).length() - 1.0).abs() < 1e-5);
+            let cone = uniform_cone(u, 0.1);
+            assert!(cone.z >= 0.9 - 1e-6);
+            let (b0, b1) = uniform_triangle(u);
+            assert!(b0 >= 0.0 && b1 >= 0.0 && b0 + b1 <= 1.0 + 1e-6);
+        }
+    }
+
+    #[test]
+    fn power_cosine_integrates_to_one() {
+        // ∫ pdf dω over the hemisphere by a Riemann sum in θ
+        for n in [0.0f32, 1.0, 10.0, 200.0] {
+            let steps = 20_000;
+            let dtheta = FRAC_PI_2 / steps as f32;
+            let total: f32 = (0..steps)
+                .map(|i| {
+                    let theta = (i as f32 + 0.5) * dtheta;
+                    power_cosine_pdf(theta.cos(), n) * 2.0 * PI * theta.sin() * dtheta
+                })
+                .sum();
+            assert!((total - 1.0).abs() < 1e-3, "n = {n}: {total}");
+        }
+    }
+}

@@ -1,0 +1,184 @@
+//! Whitted ray tracing with the thesis' local models: per light a shadow ray
+//! and `kd·Ld·(l·n) + ks·Ls·(r·v)^α` (or `(n·h)^α`), plus `ka·La`; mirrors,
+//! Phong highlights' reflectivity and glass by recursion up to a depth limit.
+//!
+//! The thesis' light colour `Ld` is taken as the light's irradiance over π,
+//! so a Lambert surface gets exactly the physical direct term ρ/π·E·cos θ and
+//! Whitted images sit beside path-traced ones at the same brightness.
+
+use std::f32::consts::FRAC_1_PI;
+
+use glam::Vec3;
+
+use super::bsdf::{reflect, refract};
+use super::rng::Sampler;
+use super::world::{Hit, World};
+use super::Counters;
+use crate::geometry::Ray;
+use crate::scene::{MaterialModel, Rgb};
+
+/// Below this path weight a reflection adds nothing visible.
+const MIN_WEIGHT: f32 = 1e-3;
+
+pub fn radiance(
+    world: &World,
+    ray: &Ray,
+    depth_left: u32,
+    weight: f32,
+    sampler: &mut Sampler,
+    counters: &mut Counters,
+) -> Rgb {
+    counters.rays += 1;
+    let Some(hit) = world.intersect(ray, f32::INFINITY) else {
+        return world.background;
+    };
+    let wo = -ray.direction;
+    let n = hit.surface.normal;
+    let facing = if wo.dot(n) < 0.0 { -n } else { n };
+    let can_recurse = depth_left > 1;
+    match *world.material_of(&hit) {
+        MaterialModel::Emissive { .. } => world.emitted(&hit, wo),
+        MaterialModel::Lambert { albedo } => {
+            albedo * world.ambient
+                + local(
+                    world,
+                    &hit,
+                    facing,
+                    wo,
+                    albedo,
+                    Rgb::ZERO,
+                    0.0,
+                    false,
+                    sampler,
+                    counters,
+                )
+        }
+        MaterialModel::Phong {
+            ka,
+            kd,
+            ks,
+            shininess,
+        }
+        | MaterialModel::BlinnPhong {
+            ka,
+            kd,
+            ks,
+            shininess,
+        } => {
+            let blinn = matches!(world.material_of(&hit), MaterialModel::BlinnPhong { .. });
+            let mut c = ka * world.ambient
+                + local(
+                    world, &hit, facing, wo, kd, ks, shininess, blinn, sampler, counters,
+                );
+            // The thesis' loop: the surface's reflectivity scales a mirror bounce
+            let w = weight * ks.max_element();
+            if can_recurse && w > MIN_WEIGHT {
+                c += ks
+                    * radiance(
+                        world,
+                        &hit.surface.spawn_ray(reflect(wo, facing)),
+                        depth_left - 1,
+                        w,
+                        sampler,
+                        counters,
+                    );
+            }
+            c
+        }
+        MaterialModel::Mirror { tint } => {
+            let w = weight * tint.max_element();
+            if !can_recurse || w <= MIN_WEIGHT {
+                return Rgb::ZERO;
+            }
+            tint * radiance(
+                world,
+                &hit.surface.spawn_ray(reflect(wo, facing)),
+                depth_left - 1,
+                w,
+                sampler,
+                counters,
+            )
+        }
+        MaterialModel::Glass { ior, tint } => {
+            if !can_recurse {
+                return Rgb::ZERO;
+            }
+            let (eta_i, eta_t) = if wo.dot(n) > 0.0 {
+                (1.0, ior)
+            } else {
+                (ior, 1.0)
+            };
+            let (fresnel, refracted, eta) = refract(wo, facing, eta_i, eta_t);
+            let mut c = Rgb::ZERO;
+            if weight * fresnel > MIN_WEIGHT {
+                let reflected = radiance(
+                    world,
+                    &hit.surface.spawn_ray(reflect(wo, facing)),
+                    depth_left - 1,
+                    weight * fresnel,
+                    sampler,
+                    counters,
+                );
+                c += fresnel * reflected;
+            }
+            if let Some(wt) = refracted {
+                let w = weight * (1.0 - fresnel);
+                if w > MIN_WEIGHT {
+                    // Radiance is compressed by η² crossing into the denser side
+                    let through = radiance(
+                        world,
+                        &hit.surface.spawn_ray(wt),
+                        depth_left - 1,
+                        w,
+                        sampler,
+                        counters,
+                    );
+                    c += (1.0 - fresnel) * eta * eta * through;
+                }
+            }
+            tint * c
+        }
+    }
+}
+
+/// The local model summed over lights that see the point.
+#[allow(clippy::too_many_arguments)]
+fn local(
+    world: &World,
+    hit: &Hit,
+    n: Vec3,
+    wo: Vec3,
+    kd: Rgb,
+    ks: Rgb,
+    exponent: f32,
+    blinn: bool,
+    sampler: &mut Sampler,
+    counters: &mut Counters,
+) -> Rgb {
+    let mut total = Rgb::ZERO;
+    for light in &world.lights {
+        let Some(sample) = light.sample(world, &hit.surface, sampler.next_2d()) else {
+            continue;
+        };
+        let cos = n.dot(sample.wi);
+        if cos <= 0.0 {
+            continue;
+        }
+        counters.rays += 1;
+        if world.occluded(&sample.shadow, sample.shadow_t_max) {
+            continue;
+        }
+        let light_colour = sample.value * FRAC_1_PI;
+        let mut c = kd * cos;
+        if ks != Rgb::ZERO {
+            let highlight = if blinn {
+                n.dot((sample.wi + wo).normalize())
+            } else {
+                reflect(sample.wi, n).dot(wo)
+            };
+            c += ks * highlight.max(0.0).powf(exponent);
+        }
+        total += light_colour * c;
+    }
+    total
+}

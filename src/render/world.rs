@@ -1,0 +1,263 @@
+//! The scene compiled for rendering: shapes in flat arrays (spheres as a
+//! structure of arrays for the nearest-hit loop), materials and lights
+//! resolved to indices, disabled lights dropped.
+
+use glam::Vec3;
+
+use super::light::LightSource;
+use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
+use crate::geometry::{plane_hit, plane_t, sphere_hit, sphere_t};
+use crate::scene::{LightKind, MaterialModel, Rgb, Scene, Shape};
+
+/// Which flat array an object's shape lives in, and where.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShapeRef {
+    Sphere(u32),
+    Plane(u32),
+    Triangle(u32),
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct ObjectInfo {
+    pub shape: ShapeRef,
+    pub material: u32,
+    /// Index into `World::lights` when the object is a sampled area light.
+    pub light: Option<u32>,
+}
+
+/// Spheres as parallel arrays: the hit loop reads only what it needs.
+#[derive(Clone, Debug, Default)]
+pub struct Spheres {
+    pub center_x: Vec<f32>,
+    pub center_y: Vec<f32>,
+    pub center_z: Vec<f32>,
+    pub radius: Vec<f32>,
+    pub object: Vec<u32>,
+}
+
+impl Spheres {
+    #[inline]
+    pub fn center(&self, i: usize) -> Vec3 {
+        Vec3::new(self.center_x[i], self.center_y[i], self.center_z[i])
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct PlaneShape {
+    pub normal: Vec3,
+    pub offset: f32,
+    pub object: u32,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    pub surface: SurfaceHit,
+    pub object: u32,
+    pub material: u32,
+}
+
+#[derive(Clone, Debug)]
+pub struct World {
+    pub spheres: Spheres,
+    pub planes: Vec<PlaneShape>,
+    pub triangles: Vec<(Triangle, u32)>,
+    pub objects: Vec<ObjectInfo>,
+    pub materials: Vec<MaterialModel>,
+    pub lights: Vec<LightSource>,
+    pub background: Rgb,
+    pub ambient: Rgb,
+    /// A sphere around everything finite (planes excluded), for emitting
+    /// photons from directional lights.
+    pub bounds_center: Vec3,
+    pub bounds_radius: f32,
+}
+
+impl World {
+    /// Compile a validated scene.
+    pub fn new(scene: &Scene) -> Self {
+        let mut world = World {
+            spheres: Spheres::default(),
+            planes: Vec::new(),
+            triangles: Vec::new(),
+            objects: Vec::with_capacity(scene.objects.len()),
+            materials: scene.materials.iter().map(|m| m.model.clone()).collect(),
+            lights: Vec::new(),
+            background: scene.background,
+            ambient: scene.ambient,
+            bounds_center: Vec3::ZERO,
+            bounds_radius: 0.0,
+        };
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for (index, object) in scene.objects.iter().enumerate() {
+            let id = index as u32;
+            let material = scene.material_index(&object.material).unwrap_or(0) as u32;
+            let shape = match &object.shape {
+                Shape::Sphere { center, radius } => {
+                    let s = &mut world.spheres;
+                    s.center_x.push(center.x);
+                    s.center_y.push(center.y);
+                    s.center_z.push(center.z);
+                    s.radius.push(*radius);
+                    s.object.push(id);
+                    lo = lo.min(*center - *radius);
+                    hi = hi.max(*center + *radius);
+                    ShapeRef::Sphere(s.radius.len() as u32 - 1)
+                }
+                Shape::Plane { point, normal } => {
+                    let normal = normal.normalize();
+                    world.planes.push(PlaneShape {
+                        normal,
+                        offset: normal.dot(*point),
+                        object: id,
+                    });
+                    ShapeRef::Plane(world.planes.len() as u32 - 1)
+                }
+                Shape::Triangle { a, b, c } => {
+                    lo = lo.min(a.min(b.min(*c)));
+                    hi = hi.max(a.max(b.max(*c)));
+                    world.triangles.push((Triangle::new(*a, *b, *c), id));
+                    ShapeRef::Triangle(world.triangles.len() as u32 - 1)
+                }
+            };
+            world.objects.push(ObjectInfo {
+                shape,
+                material,
+                light: None,
+            });
+        }
+        if lo.x <= hi.x {
+            world.bounds_center = (lo + hi) * 0.5;
+            world.bounds_radius = (hi - lo).length() * 0.5;
+        }
+        // Disabled lights are simply absent from the render
+        for light in scene.lights.iter().filter(|l| l.enabled) {
+            let power = light.color * light.intensity;
+            world.lights.push(match light.kind {
+                LightKind::Point { position } => LightSource::Point {
+                    position,
+                    intensity: power,
+                    attenuation: light.attenuation,
+                },
+                LightKind::Directional { direction } => LightSource::Directional {
+                    direction: direction.normalize(),
+                    irradiance: power,
+                },
+                LightKind::Spot {
+                    position,
+                    direction,
+                    cone_angle_degrees,
+                    falloff_exponent,
+                } => LightSource::Spot {
+                    position,
+                    direction: direction.normalize(),
+                    cos_cone: cone_angle_degrees.to_radians().cos(),
+                    exponent: falloff_exponent,
+                    intensity: power,
+                    attenuation: light.attenuation,
+                },
+            });
+        }
+        // Emissive spheres and triangles become sampled area lights; an
+        // emissive infinite plane cannot be sampled and is only found by rays.
+        for index in 0..world.objects.len() {
+            let info = world.objects[index];
+            if let MaterialModel::Emissive { radiance } = world.materials[info.material as usize] {
+                let sampled = match info.shape {
+                    ShapeRef::Sphere(_) => true,
+                    ShapeRef::Triangle(t) => !world.triangles[t as usize].0.is_degenerate(),
+                    ShapeRef::Plane(_) => false,
+                };
+                if sampled && radiance.max_element() > 0.0 {
+                    world.objects[index].light = Some(world.lights.len() as u32);
+                    world.lights.push(LightSource::Area {
+                        object: index as u32,
+                        radiance,
+                    });
+                }
+            }
+        }
+        world
+    }
+
+    /// Nearest hit in (0, t_max).
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let mut best_t = t_max;
+        let mut best = None;
+        let mut sphere_near = true;
+        let s = &self.spheres;
+        for i in 0..s.radius.len() {
+            if let Some((t, near)) = sphere_t(ray, s.center(i), s.radius[i], best_t) {
+                best_t = t;
+                best = Some(ShapeRef::Sphere(i as u32));
+                sphere_near = near;
+            }
+        }
+        for (i, plane) in self.planes.iter().enumerate() {
+            if let Some(t) = plane_t(ray, plane.normal, plane.offset, best_t) {
+                best_t = t;
+                best = Some(ShapeRef::Plane(i as u32));
+            }
+        }
+        let mut triangle_hit = None;
+        for (i, (triangle, _)) in self.triangles.iter().enumerate() {
+            if let Some(hit) = intersect_triangle(ray, triangle, best_t) {
+                best_t = hit.t;
+                best = Some(ShapeRef::Triangle(i as u32));
+                triangle_hit = Some(hit);
+            }
+        }
+        let (surface, object) = match best? {
+            ShapeRef::Sphere(i) => {
+                let i = i as usize;
+                (
+                    sphere_hit(ray, s.center(i), s.radius[i], best_t, sphere_near),
+                    s.object[i],
+                )
+            }
+            ShapeRef::Plane(i) => {
+                let plane = &self.planes[i as usize];
+                (
+                    plane_hit(ray, plane.normal, plane.offset, best_t),
+                    plane.object,
+                )
+            }
+            ShapeRef::Triangle(i) => (triangle_hit?, self.triangles[i as usize].1),
+        };
+        Some(Hit {
+            surface,
+            object,
+            material: self.objects[object as usize].material,
+        })
+    }
+
+    /// Whether anything lies on the ray in (0, t_max): shadow rays stop at the
+    /// first blocker.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        let s = &self.spheres;
+        (0..s.radius.len()).any(|i| sphere_t(ray, s.center(i), s.radius[i], t_max).is_some())
+            || self
+                .planes
+                .iter()
+                .any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
+            || self
+                .triangles
+                .iter()
+                .any(|(t, _)| intersect_triangle(ray, t, t_max).is_some())
+    }
+
+    #[inline]
+    pub fn material_of(&self, hit: &Hit) -> &MaterialModel {
+        &self.materials[hit.material as usize]
+    }
+
+    /// Radiance emitted from a hit toward `wo` (front side only).
+    #[inline]
+    pub fn emitted(&self, hit: &Hit, wo: Vec3) -> Rgb {
+        match self.materials[hit.material as usize] {
+            MaterialModel::Emissive { radiance } if hit.surface.normal.dot(wo) > 0.0 => radiance,
+            _ => Rgb::ZERO,
+        }
+    }
+}

@@ -1,0 +1,149 @@
+//! Scene files in RON: load with errors that name file, line, column and
+//! field; save in a form that loads back to an equal scene.
+
+use std::path::{Path, PathBuf};
+
+use super::{Invalid, Scene};
+
+#[derive(Debug, thiserror::Error)]
+pub enum SceneFileError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The text is not a well-formed scene (bad syntax, unknown or missing field).
+    #[error("{path}:{line}:{column}: {message}")]
+    Syntax {
+        path: PathBuf,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    /// Well-formed but a value is unusable; the position is the field's.
+    #[error("{path}:{line}:{column}: {invalid}{more}", more = more_note(*.others))]
+    Invalid {
+        path: PathBuf,
+        line: usize,
+        column: usize,
+        invalid: Invalid,
+        others: usize,
+    },
+    #[error("could not write the scene: {0}")]
+    Serialize(String),
+}
+
+fn more_note(others: usize) -> String {
+    match others {
+        0 => String::new(),
+        n => format!(" (and {n} more problem{})", if n == 1 { "" } else { "s" }),
+    }
+}
+
+/// Read and validate a scene file.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneFileError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneFileError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    parse_scene(&text, path)
+}
+
+/// Parse and validate scene text; `path` is only used in messages.
+pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneFileError> {
+    let scene: Scene =
+        ron::Options::default()
+            .from_str(text)
+            .map_err(|e| SceneFileError::Syntax {
+                path: path.to_owned(),
+                line: e.span.start.line,
+                column: e.span.start.col,
+                message: e.code.to_string(),
+            })?;
+    let mut problems = scene.validate();
+    if problems.is_empty() {
+        return Ok(scene);
+    }
+    let others = problems.len() - 1;
+    let invalid = problems.swap_remove(0);
+    let (line, column) = locate(text, &invalid);
+    Err(SceneFileError::Invalid {
+        path: path.to_owned(),
+        line,
+        column,
+        invalid,
+        others,
+    })
+}
+
+pub fn to_ron(scene: &Scene) -> Result<String, SceneFileError> {
+    let config = ron::ser::PrettyConfig::new()
+        .depth_limit(4)
+        .struct_names(false);
+    ron::ser::to_string_pretty(scene, config).map_err(|e| SceneFileError::Serialize(e.to_string()))
+}
+
+/// Write the scene; written to a temporary file first so a failed save never
+/// leaves half a scene behind.
+pub fn save_scene(scene: &Scene, path: &Path) -> Result<(), SceneFileError> {
+    let text = to_ron(scene)?;
+    let io = |source| SceneFileError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    let partial = path.with_extension("ron.partial");
+    std::fs::write(&partial, text + "\n").map_err(io)?;
+    std::fs::rename(&partial, path).map_err(io)
+}
+
+/// Where an invalid value sits in the text: the section, then the item's
+/// quoted name (the duplicate's second occurrence), then `key:`. RON gives no
+/// spans after deserialising, and names are unique, so this finds the field.
+fn locate(text: &str, invalid: &Invalid) -> (usize, usize) {
+    let section = if invalid.section == "scene" {
+        Some(0)
+    } else {
+        find_key(text, 0, invalid.section)
+    };
+    let mut at = section.unwrap_or(0);
+    if let Some(item) = &invalid.item {
+        let quoted = format!("\"{item}\"");
+        if let Some(found) = text[at..].find(&quoted) {
+            at += found;
+            if matches!(invalid.problem, super::Problem::DuplicateName(_)) {
+                if let Some(again) = text[at + quoted.len()..].find(&quoted) {
+                    at += quoted.len() + again;
+                }
+            }
+        }
+    }
+    if !matches!(invalid.problem, super::Problem::DuplicateName(_)) {
+        if let Some(found) = find_key(text, at, invalid.key) {
+            at = found;
+        }
+    }
+    line_column(text, at)
+}
+
+/// Byte offset of `key` followed by optional spaces and `:` at or after `from`.
+fn find_key(text: &str, from: usize, key: &str) -> Option<usize> {
+    let mut start = from;
+    while let Some(found) = text[start..].find(key) {
+        let at = start + found;
+        let before_ok = at == 0
+            || !text.as_bytes()[at - 1].is_ascii_alphanumeric() && text.as_bytes()[at - 1] != b'_';
+        let after = text[at + key.len()..].trim_start();
+        if before_ok && after.starts_with(':') {
+            return Some(at);
+        }
+        start = at + key.len();
+    }
+    None
+}
+
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rfind('\n').map_or(offset, |nl| offset - nl - 1) + 1;
+    (line, column)
+}

@@ -1,0 +1,254 @@
+//! The scene as the user edits and saves it: camera, background, materials,
+//! objects and lights. Closed sets are enums (all variants visible here); the
+//! whole scene is `Clone + Send` so the engine renders from snapshots.
+
+mod file;
+pub mod presets;
+mod validate;
+
+pub use file::{load_scene, parse_scene, save_scene, to_ron, SceneFileError};
+pub use validate::{Invalid, Problem};
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// Linear RGB radiance, reflectance or power. An alias rather than a newtype:
+/// colours need the same arithmetic as vectors; names say which is which.
+pub type Rgb = Vec3;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    pub camera: Camera,
+    /// Radiance of rays that leave the scene.
+    #[serde(default)]
+    pub background: Rgb,
+    /// Ambient light `La` of the thesis' local models (Whitted only).
+    #[serde(default)]
+    pub ambient: Rgb,
+    #[serde(default)]
+    pub settings: SceneSettings,
+    pub materials: Vec<Material>,
+    pub objects: Vec<Object>,
+    #[serde(default)]
+    pub lights: Vec<Light>,
+}
+
+/// A pinhole or thin-lens camera.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    pub position: Vec3,
+    pub look_at: Vec3,
+    pub up: Vec3,
+    /// Vertical field of view in degrees.
+    pub fov_y_degrees: f32,
+    /// Primary rays start where they cross the plane this far along the view
+    /// axis (smallpt's `+d*140`); 0 starts them at the camera.
+    #[serde(default)]
+    pub near_clip: f32,
+    /// Thin-lens radius; 0 is a pinhole.
+    #[serde(default)]
+    pub aperture_radius: f32,
+    /// Distance of the plane in focus; 0 focuses on `look_at`.
+    #[serde(default)]
+    pub focus_distance: f32,
+}
+
+/// What a scene asks of the image by default (flags may override).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SceneSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Exposure in stops applied before tone mapping.
+    pub exposure: f32,
+}
+
+impl Default for SceneSettings {
+    fn default() -> Self {
+        Self {
+            width: 640,
+            height: 480,
+            exposure: 0.0,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    pub name: String,
+    pub model: MaterialModel,
+}
+
+/// Surface models. Lambert, Phong and Blinn–Phong are the thesis' local
+/// models: Whitted uses them as written, the Monte Carlo algorithms as
+/// energy-conserving (normalised) BRDFs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum MaterialModel {
+    Lambert {
+        albedo: Rgb,
+    },
+    Phong {
+        ka: Rgb,
+        kd: Rgb,
+        ks: Rgb,
+        shininess: f32,
+    },
+    BlinnPhong {
+        ka: Rgb,
+        kd: Rgb,
+        ks: Rgb,
+        shininess: f32,
+    },
+    Mirror {
+        tint: Rgb,
+    },
+    Glass {
+        ior: f32,
+        tint: Rgb,
+    },
+    /// A black surface that emits `radiance` from its front side (outward for
+    /// spheres, along the normal for planes and triangles): an area light.
+    Emissive {
+        radiance: Rgb,
+    },
+}
+
+impl MaterialModel {
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Self::Lambert { .. } => "Lambert",
+            Self::Phong { .. } => "Phong",
+            Self::BlinnPhong { .. } => "Blinn–Phong",
+            Self::Mirror { .. } => "Mirror",
+            Self::Glass { .. } => "Glass",
+            Self::Emissive { .. } => "Emissive",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Object {
+    pub name: String,
+    pub shape: Shape,
+    /// Name of an entry of `Scene::materials`.
+    pub material: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Shape {
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    /// The infinite plane through `point` facing `normal`.
+    Plane {
+        point: Vec3,
+        normal: Vec3,
+    },
+    /// Front side given by the winding: normal ∝ (b − a) × (c − a).
+    Triangle {
+        a: Vec3,
+        b: Vec3,
+        c: Vec3,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Light {
+    pub name: String,
+    pub kind: LightKind,
+    pub color: Rgb,
+    /// Scales `color`: radiant intensity (W/sr) for point and spot lights,
+    /// irradiance at normal incidence for directional lights.
+    pub intensity: f32,
+    /// Distance falloff `1/(a·d² + b·d + c)`; ignored by directional lights.
+    #[serde(default)]
+    pub attenuation: Attenuation,
+    #[serde(default = "enabled_by_default")]
+    pub enabled: bool,
+}
+
+fn enabled_by_default() -> bool {
+    true
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum LightKind {
+    Point {
+        position: Vec3,
+    },
+    /// Light from infinitely far away travelling along `direction`.
+    Directional {
+        direction: Vec3,
+    },
+    /// A point light restricted to a cone around `direction`, with the
+    /// thesis' falloff `(Vp·Va)^σ` inside it.
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        cone_angle_degrees: f32,
+        falloff_exponent: f32,
+    },
+}
+
+impl LightKind {
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Self::Point { .. } => "Point",
+            Self::Directional { .. } => "Directional",
+            Self::Spot { .. } => "Spot",
+        }
+    }
+}
+
+/// Coefficients of `1/(a·d² + b·d + c)`; the default is the physical `1/d²`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Attenuation {
+    pub a: f32,
+    pub b: f32,
+    pub c: f32,
+}
+
+impl Default for Attenuation {
+    fn default() -> Self {
+        Self {
+            a: 1.0,
+            b: 0.0,
+            c: 0.0,
+        }
+    }
+}
+
+impl Attenuation {
+    #[inline]
+    pub fn factor(&self, distance: f32) -> f32 {
+        1.0 / (self.a * distance * distance + self.b * distance + self.c)
+    }
+}
+
+impl Scene {
+    pub fn material_index(&self, name: &str) -> Option<usize> {
+        self.materials.iter().position(|m| m.name == name)
+    }
+
+    /// Every problem with the scene, in document order; empty when it can be
+    /// rendered.
+    pub fn validate(&self) -> Vec<Invalid> {
+        validate::validate(self)
+    }
+
+    /// A stable 64-bit key of the scene's content (FNV-1a of its RON form),
+    /// used to tie saved photon maps and references to the scene they belong to.
+    pub fn content_key(&self) -> u64 {
+        let text = to_ron(self).unwrap_or_default();
+        text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+            (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
+        })
+    }
+}

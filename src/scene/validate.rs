@@ -1,0 +1,327 @@
+//! Every value checked before a scene reaches the engine, with a problem that
+//! says what is wrong and a path that says where.
+
+use std::collections::HashSet;
+
+use glam::Vec3;
+
+use super::{LightKind, MaterialModel, Scene, Shape};
+
+/// One invalid value: where it is (a readable path plus what the file locator
+/// needs) and what is wrong with it.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{field}: {problem}")]
+pub struct Invalid {
+    /// e.g. `objects[2] "glass ball".shape.radius`.
+    pub field: String,
+    /// Top-level section: `camera`, `settings`, `materials`, `objects`, `lights`.
+    pub section: &'static str,
+    /// The name of the list item, when the value belongs to one.
+    pub item: Option<String>,
+    /// The last field name on the path (`radius`).
+    pub key: &'static str,
+    pub problem: Problem,
+}
+
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Problem {
+    #[error("must be a finite number, found {0}")]
+    NotFinite(f32),
+    #[error("must be greater than zero, found {0}")]
+    NotPositive(f32),
+    #[error("must not be negative, found {0}")]
+    Negative(f32),
+    #[error("must be between {min} and {max}, found {found}")]
+    OutOfRange { min: f32, max: f32, found: f32 },
+    #[error("cone angle must be in (0°, 90°], found {0}°")]
+    ConeAngle(f32),
+    #[error("must not be a zero-length vector")]
+    ZeroLength,
+    #[error("the up vector is parallel to the view direction")]
+    UpParallelToView,
+    #[error("attenuation a = b = c = 0 would divide by zero")]
+    ZeroAttenuation,
+    #[error("refers to material \"{0}\", which the scene does not define")]
+    UnknownMaterial(String),
+    #[error("the name \"{0}\" is used twice")]
+    DuplicateName(String),
+    #[error("must not be empty")]
+    EmptyName,
+}
+
+struct Checker<'a> {
+    found: Vec<Invalid>,
+    section: &'static str,
+    item: Option<&'a str>,
+    prefix: String,
+}
+
+impl<'a> Checker<'a> {
+    fn at(
+        &mut self,
+        section: &'static str,
+        index: Option<usize>,
+        item: Option<&'a str>,
+        middle: &str,
+    ) {
+        self.section = section;
+        self.item = item;
+        self.prefix = match (index, item) {
+            (Some(i), Some(name)) => format!("{section}[{i}] \"{name}\"{middle}"),
+            (Some(i), None) => format!("{section}[{i}]{middle}"),
+            _ => format!("{section}{middle}"),
+        };
+    }
+
+    fn report(&mut self, key: &'static str, problem: Problem) {
+        self.found.push(Invalid {
+            field: format!("{}.{key}", self.prefix),
+            section: self.section,
+            item: self.item.map(str::to_owned),
+            key,
+            problem,
+        });
+    }
+
+    fn finite(&mut self, key: &'static str, v: f32) -> bool {
+        if v.is_finite() {
+            return true;
+        }
+        self.report(key, Problem::NotFinite(v));
+        false
+    }
+
+    fn vector(&mut self, key: &'static str, v: Vec3) -> bool {
+        v.to_array().iter().all(|c| self.finite(key, *c))
+    }
+
+    fn direction(&mut self, key: &'static str, v: Vec3) {
+        if self.vector(key, v) && v.length_squared() == 0.0 {
+            self.report(key, Problem::ZeroLength);
+        }
+    }
+
+    fn positive(&mut self, key: &'static str, v: f32) {
+        if self.finite(key, v) && v <= 0.0 {
+            self.report(key, Problem::NotPositive(v));
+        }
+    }
+
+    fn non_negative(&mut self, key: &'static str, v: f32) {
+        if self.finite(key, v) && v < 0.0 {
+            self.report(key, Problem::Negative(v));
+        }
+    }
+
+    fn colour(&mut self, key: &'static str, v: Vec3) {
+        if self.vector(key, v) {
+            if let Some(c) = v.to_array().into_iter().find(|c| *c < 0.0) {
+                self.report(key, Problem::Negative(c));
+            }
+        }
+    }
+
+    fn reflectance(&mut self, key: &'static str, v: Vec3) {
+        if self.vector(key, v) {
+            if let Some(c) = v.to_array().into_iter().find(|c| !(0.0..=1.0).contains(c)) {
+                self.report(
+                    key,
+                    Problem::OutOfRange {
+                        min: 0.0,
+                        max: 1.0,
+                        found: c,
+                    },
+                );
+            }
+        }
+    }
+
+    fn name(&mut self, seen: &mut HashSet<&'a str>, name: &'a str) {
+        if name.trim().is_empty() {
+            self.report("name", Problem::EmptyName);
+        } else if !seen.insert(name) {
+            self.report("name", Problem::DuplicateName(name.to_owned()));
+        }
+    }
+}
+
+pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
+    let mut check = Checker {
+        found: Vec::new(),
+        section: "camera",
+        item: None,
+        prefix: String::new(),
+    };
+
+    let camera = &scene.camera;
+    check.at("camera", None, None, "");
+    let placed =
+        check.vector("position", camera.position) & check.vector("look_at", camera.look_at);
+    if check.vector("up", camera.up) {
+        if camera.up.length_squared() == 0.0 {
+            check.report("up", Problem::ZeroLength);
+        } else if placed {
+            let view = camera.look_at - camera.position;
+            if view.length_squared() == 0.0 {
+                check.report("look_at", Problem::ZeroLength);
+            } else if view.normalize().cross(camera.up.normalize()).length() < 1e-6 {
+                check.report("up", Problem::UpParallelToView);
+            }
+        }
+    }
+    if check.finite("fov_y_degrees", camera.fov_y_degrees)
+        && !(camera.fov_y_degrees > 0.0 && camera.fov_y_degrees < 180.0)
+    {
+        check.report(
+            "fov_y_degrees",
+            Problem::OutOfRange {
+                min: 0.0,
+                max: 180.0,
+                found: camera.fov_y_degrees,
+            },
+        );
+    }
+    check.non_negative("near_clip", camera.near_clip);
+    check.non_negative("aperture_radius", camera.aperture_radius);
+    check.non_negative("focus_distance", camera.focus_distance);
+
+    check.at("settings", None, None, "");
+    for (key, v) in [
+        ("width", scene.settings.width),
+        ("height", scene.settings.height),
+    ] {
+        if !(1..=16384).contains(&v) {
+            check.report(
+                key,
+                Problem::OutOfRange {
+                    min: 1.0,
+                    max: 16384.0,
+                    found: v as f32,
+                },
+            );
+        }
+    }
+    check.finite("exposure", scene.settings.exposure);
+    check.at("scene", None, None, "");
+    check.colour("background", scene.background);
+    check.colour("ambient", scene.ambient);
+
+    let mut names = HashSet::new();
+    for (i, material) in scene.materials.iter().enumerate() {
+        check.at("materials", Some(i), Some(&material.name), "");
+        check.name(&mut names, &material.name);
+        check.at("materials", Some(i), Some(&material.name), ".model");
+        match &material.model {
+            MaterialModel::Lambert { albedo } => check.reflectance("albedo", *albedo),
+            MaterialModel::Phong {
+                ka,
+                kd,
+                ks,
+                shininess,
+            }
+            | MaterialModel::BlinnPhong {
+                ka,
+                kd,
+                ks,
+                shininess,
+            } => {
+                check.reflectance("ka", *ka);
+                check.reflectance("kd", *kd);
+                check.reflectance("ks", *ks);
+                check.non_negative("shininess", *shininess);
+            }
+            MaterialModel::Mirror { tint } => check.reflectance("tint", *tint),
+            MaterialModel::Glass { ior, tint } => {
+                check.positive("ior", *ior);
+                check.reflectance("tint", *tint);
+            }
+            MaterialModel::Emissive { radiance } => check.colour("radiance", *radiance),
+        }
+    }
+
+    let mut names = HashSet::new();
+    for (i, object) in scene.objects.iter().enumerate() {
+        check.at("objects", Some(i), Some(&object.name), "");
+        check.name(&mut names, &object.name);
+        if scene.material_index(&object.material).is_none() {
+            check.report(
+                "material",
+                Problem::UnknownMaterial(object.material.clone()),
+            );
+        }
+        check.at("objects", Some(i), Some(&object.name), ".shape");
+        match &object.shape {
+            Shape::Sphere { center, radius } => {
+                check.vector("center", *center);
+                check.positive("radius", *radius);
+            }
+            Shape::Plane { point, normal } => {
+                check.vector("point", *point);
+                check.direction("normal", *normal);
+            }
+            // Degenerate triangles are allowed: they are never hit.
+            Shape::Triangle { a, b, c } => {
+                check.vector("a", *a);
+                check.vector("b", *b);
+                check.vector("c", *c);
+            }
+        }
+    }
+
+    let mut names = HashSet::new();
+    for (i, light) in scene.lights.iter().enumerate() {
+        check.at("lights", Some(i), Some(&light.name), "");
+        check.name(&mut names, &light.name);
+        check.colour("color", light.color);
+        check.non_negative("intensity", light.intensity);
+        let falloff = &light.attenuation;
+        let directional = matches!(light.kind, LightKind::Directional { .. });
+        check.at("lights", Some(i), Some(&light.name), ".attenuation");
+        let finite = check.finite("a", falloff.a)
+            & check.finite("b", falloff.b)
+            & check.finite("c", falloff.c);
+        if finite && !directional {
+            if falloff.a < 0.0 || falloff.b < 0.0 || falloff.c < 0.0 {
+                let key = if falloff.a < 0.0 {
+                    "a"
+                } else if falloff.b < 0.0 {
+                    "b"
+                } else {
+                    "c"
+                };
+                check.report(
+                    key,
+                    Problem::Negative(falloff.a.min(falloff.b).min(falloff.c)),
+                );
+            } else if falloff.a == 0.0 && falloff.b == 0.0 && falloff.c == 0.0 {
+                check.report("a", Problem::ZeroAttenuation);
+            }
+        }
+        check.at("lights", Some(i), Some(&light.name), ".kind");
+        match &light.kind {
+            LightKind::Point { position } => {
+                check.vector("position", *position);
+            }
+            LightKind::Directional { direction } => check.direction("direction", *direction),
+            LightKind::Spot {
+                position,
+                direction,
+                cone_angle_degrees,
+                falloff_exponent,
+            } => {
+                check.vector("position", *position);
+                check.direction("direction", *direction);
+                if check.finite("cone_angle_degrees", *cone_angle_degrees)
+                    && !(*cone_angle_degrees > 0.0 && *cone_angle_degrees <= 90.0)
+                {
+                    check.report(
+                        "cone_angle_degrees",
+                        Problem::ConeAngle(*cone_angle_degrees),
+                    );
+                }
+                check.non_negative("falloff_exponent", *falloff_exponent);
+            }
+        }
+    }
+    check.found
+}
