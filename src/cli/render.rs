@@ -46,33 +46,20 @@ impl RenderFlags {
 
 pub fn run(args: &RenderArgs) -> Result<()> {
     let scene = load_scene(&args.scene)?;
-    let extension = args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
+    let extension = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if !matches!(extension.as_deref(), Some("png" | "exr")) {
-        bail!(
-            "{}: the output must end in .png or .exr",
-            args.output.display()
-        );
+        bail!("{}: the output must end in .png or .exr", args.output.display());
     }
     let settings = args.flags.settings(&scene);
     let exposure = args.flags.exposure.unwrap_or(scene.settings.exposure);
     let (image, stats) = render_with_progress(scene, settings.clone())?;
     image.save(&args.output, exposure)?;
-    println!(
-        "{}",
-        summary_line(&settings, &stats, &args.output.display().to_string())
-    );
+    println!("{}", summary_line(&settings, &stats, &args.output.display().to_string()));
     Ok(())
 }
 
 /// Render on a session, showing passes (or seconds) on a progress bar.
-pub fn render_with_progress(
-    scene: Scene,
-    settings: RenderSettings,
-) -> Result<(crate::render::LinearImage, PassStats)> {
+pub fn render_with_progress(scene: Scene, settings: RenderSettings) -> Result<(crate::render::LinearImage, PassStats)> {
     let bar = match (settings.samples_per_pixel, settings.time_limit) {
         (_, Some(seconds)) => ProgressBar::new((seconds * 10.0).ceil() as u64),
         (Some(spp), None) => ProgressBar::new(spp as u64),
@@ -80,17 +67,12 @@ pub fn render_with_progress(
     };
     let template = "{spinner} {elapsed_precise} [{bar:40}] {msg}";
     bar.set_style(
-        ProgressStyle::with_template(template)
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
+        ProgressStyle::with_template(template).unwrap_or_else(|_| ProgressStyle::default_bar()).progress_chars("=> "),
     );
     bar.enable_steady_tick(Duration::from_millis(200));
     let timed = settings.time_limit.is_some();
     let session = RenderSession::new(None);
-    let generation = session.start(RenderJob {
-        scene: Arc::new(scene),
-        settings,
-    });
+    let generation = session.start(RenderJob { scene: Arc::new(scene), settings });
     let result = loop {
         let Ok(event) = session.events().recv() else {
             bail!("the render worker stopped unexpectedly");
@@ -100,22 +82,11 @@ pub fn render_with_progress(
         }
         match event {
             RenderEvent::PassFinished { stats, .. } => {
-                bar.set_position(if timed {
-                    (stats.elapsed.as_secs_f64() * 10.0) as u64
-                } else {
-                    stats.passes as u64
-                });
-                bar.set_message(format!(
-                    "{} spp, {:.2} M samples/s",
-                    stats.passes,
-                    stats.samples_per_second() / 1e6
-                ));
+                bar.set_position(if timed { (stats.elapsed.as_secs_f64() * 10.0) as u64 } else { stats.passes as u64 });
+                bar.set_message(format!("{} spp, {:.2} M samples/s", stats.passes, stats.samples_per_second() / 1e6));
             }
             RenderEvent::Finished { image, stats, .. } => {
-                break (
-                    Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone()),
-                    stats,
-                )
+                break (Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone()), stats)
             }
             RenderEvent::Failed { message, .. } => bail!("{message}"),
             RenderEvent::Started { .. } | RenderEvent::Tile(_) => {}

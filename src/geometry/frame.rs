@@ -39,12 +39,7 @@ mod tests {
 
     #[test]
     fn basis_is_orthonormal_for_awkward_normals() {
-        for z in [
-            Vec3::Z,
-            -Vec3::Z,
-            Vec3::X,
-            Vec3::new(1.0, 2.0, -3.0).normalize(),
-        ] {
+        for z in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(1.0, 2.0, -3.0).normalize()] {
             let f = Frame::from_z(z);
             for (a, b) in [(f.x, f.y), (f.y, f.z), (f.x, f.z)] {
                 assert!(a.dot(b).abs() < 1e-6);
@@ -52,11 +47,7 @@ mod tests {
             for v in [f.x, f.y, f.z] {
                 assert!((v.length() - 1.0).abs() < 1e-6);
             }
-            assert!(
-                (f.to_local(f.to_world(Vec3::new(0.3, -0.2, 0.9))) - Vec3::new(0.3, -0.2, 0.9))
-                    .length()
-                    < 1e-6
-            );
+            assert!((f.to_local(f.to_world(Vec3::new(0.3, -0.2, 0.9))) - Vec3::new(0.3, -0.2, 0.9)).length() < 1e-6);
         }
     }
 }

@@ -39,10 +39,7 @@ impl SurfaceHit {
     /// of the surface the direction points to, so it cannot re-hit the surface.
     #[inline]
     pub fn spawn_ray(&self, direction: Vec3) -> Ray {
-        Ray::new(
-            offset_ray_origin(self.point, self.error, self.normal, direction),
-            direction,
-        )
+        Ray::new(offset_ray_origin(self.point, self.error, self.normal, direction), direction)
     }
 
     /// A ray from this hit toward `target`, with `t_max` just short of it, for

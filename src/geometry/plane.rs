@@ -25,12 +25,7 @@ pub(crate) fn plane_hit(ray: &Ray, normal: Vec3, offset: f32, t: f32) -> Surface
     // Re-project onto the plane so the error does not grow with t
     let along = ray.at(t);
     let point = along - normal * (normal.dot(along) - offset);
-    SurfaceHit {
-        t,
-        point,
-        normal,
-        error: gamma(7) * (point.abs().element_sum() + offset.abs()),
-    }
+    SurfaceHit { t, point, normal, error: gamma(7) * (point.abs().element_sum() + offset.abs()) }
 }
 
 #[cfg(test)]
@@ -40,34 +35,16 @@ mod tests {
     #[test]
     fn parallel_and_in_plane_rays_miss() {
         let n = Vec3::Y;
-        assert!(intersect_plane(
-            &Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::X),
-            n,
-            0.0,
-            f32::INFINITY
-        )
-        .is_none());
+        assert!(intersect_plane(&Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::X), n, 0.0, f32::INFINITY).is_none());
         assert!(intersect_plane(&Ray::new(Vec3::ZERO, Vec3::X), n, 0.0, f32::INFINITY).is_none());
         // -0.0 components are parallel too
-        assert!(intersect_plane(
-            &Ray::new(Vec3::Y, Vec3::new(1.0, -0.0, 0.0)),
-            n,
-            0.0,
-            f32::INFINITY
-        )
-        .is_none());
+        assert!(intersect_plane(&Ray::new(Vec3::Y, Vec3::new(1.0, -0.0, 0.0)), n, 0.0, f32::INFINITY).is_none());
     }
 
     #[test]
     fn long_ray_lands_on_the_plane() {
         let d = Vec3::new(1.0, -1.0e-6, 0.0).normalize();
-        let hit = intersect_plane(
-            &Ray::new(Vec3::new(0.0, 1.0, 0.0), d),
-            Vec3::Y,
-            0.0,
-            f32::INFINITY,
-        )
-        .unwrap();
+        let hit = intersect_plane(&Ray::new(Vec3::new(0.0, 1.0, 0.0), d), Vec3::Y, 0.0, f32::INFINITY).unwrap();
         assert!(hit.t > 9.0e5 && hit.t.is_finite());
         assert!(hit.point.y.abs() <= hit.error);
     }

@@ -52,18 +52,10 @@ pub(crate) fn spawn_offset_scale(p: Vec3) -> f32 {
 #[inline]
 pub fn offset_ray_origin(point: Vec3, error: f32, normal: Vec3, direction: Vec3) -> Vec3 {
     let distance = error * normal.abs().element_sum() + spawn_offset_scale(point);
-    let offset = if direction.dot(normal) < 0.0 {
-        -normal * distance
-    } else {
-        normal * distance
-    };
+    let offset = if direction.dot(normal) < 0.0 { -normal * distance } else { normal * distance };
     let moved = point + offset;
     // Round away from the point so the offset survives the addition.
-    Vec3::new(
-        next_away(moved.x, offset.x),
-        next_away(moved.y, offset.y),
-        next_away(moved.z, offset.z),
-    )
+    Vec3::new(next_away(moved.x, offset.x), next_away(moved.y, offset.y), next_away(moved.z, offset.z))
 }
 
 #[inline]

@@ -54,23 +54,10 @@ pub(crate) fn sphere_hit(ray: &Ray, center: Vec3, radius: f32, t: f32, near: boo
     let f = ray.origin - center;
     let closest = f - f.dot(ray.direction) * ray.direction;
     let half_chord = (radius * radius - closest.length_squared()).max(0.0).sqrt();
-    let from_center = if near {
-        closest - half_chord * ray.direction
-    } else {
-        closest + half_chord * ray.direction
-    };
+    let from_center = if near { closest - half_chord * ray.direction } else { closest + half_chord * ray.direction };
     let length = from_center.length();
-    let normal = if length > 0.0 {
-        from_center / length
-    } else {
-        -ray.direction
-    };
-    SurfaceHit {
-        t,
-        point: center + normal * radius,
-        normal,
-        error: gamma(6) * (center.abs().max_element() + radius),
-    }
+    let normal = if length > 0.0 { from_center / length } else { -ray.direction };
+    SurfaceHit { t, point: center + normal * radius, normal, error: gamma(6) * (center.abs().max_element() + radius) }
 }
 
 #[cfg(test)]
@@ -108,24 +95,13 @@ mod tests {
         let center = Vec3::new(1.0e5 + 1.0, 40.8, 81.6);
         let origin = Vec3::new(50.0, 52.0, 155.6);
         // The room is inside every wall's sphere: the wall at x = 1 is its near side
-        for dir in [
-            Vec3::new(-1.0, 0.0, -1.0),
-            Vec3::new(-1.0, -0.3, -0.2),
-            Vec3::new(-0.6, 0.1, -1.0),
-        ] {
+        for dir in [Vec3::new(-1.0, 0.0, -1.0), Vec3::new(-1.0, -0.3, -0.2), Vec3::new(-0.6, 0.1, -1.0)] {
             let d = dir.normalize();
             let hit = intersect_sphere(&Ray::new(origin, d), center, 1.0e5, f32::INFINITY).unwrap();
             let t = oracle(origin.as_dvec3(), d.as_dvec3(), center.as_dvec3(), 1.0e5).unwrap();
-            assert!(
-                (hit.t as f64 - t).abs() < 1e-3 * t.max(1.0),
-                "{} vs {t}",
-                hit.t
-            );
+            assert!((hit.t as f64 - t).abs() < 1e-3 * t.max(1.0), "{} vs {t}", hit.t);
             assert!(hit.point.x > 0.9 && hit.point.x < 1.1);
-            assert!(
-                hit.error >= 1e-3,
-                "error bound must cover the centre's rounding"
-            );
+            assert!(hit.error >= 1e-3, "error bound must cover the centre's rounding");
         }
     }
 
@@ -138,13 +114,9 @@ mod tests {
                 assert!((hit.point.length() - 1.0).abs() < 1e-5);
             }
         }
-        assert!(intersect_sphere(
-            &Ray::new(Vec3::new(-5.0, 1.001, 0.0), Vec3::X),
-            Vec3::ZERO,
-            1.0,
-            f32::INFINITY
-        )
-        .is_none());
+        assert!(
+            intersect_sphere(&Ray::new(Vec3::new(-5.0, 1.001, 0.0), Vec3::X), Vec3::ZERO, 1.0, f32::INFINITY).is_none()
+        );
     }
 
     #[test]

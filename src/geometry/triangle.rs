@@ -15,15 +15,8 @@ impl Triangle {
         // Normal in f64 so thin but valid triangles far from the origin keep one
         let n = (b.as_dvec3() - a.as_dvec3()).cross(c.as_dvec3() - a.as_dvec3());
         let length = n.length();
-        let normal = if length > 0.0 && length.is_finite() {
-            (n / length).as_vec3()
-        } else {
-            Vec3::ZERO
-        };
-        Self {
-            vertices: [a, b, c],
-            normal,
-        }
+        let normal = if length > 0.0 && length.is_finite() { (n / length).as_vec3() } else { Vec3::ZERO };
+        Self { vertices: [a, b, c], normal }
     }
 
     pub fn is_degenerate(&self) -> bool {
@@ -104,21 +97,14 @@ pub fn intersect_triangle(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<
     let delta_y = gamma(5) * (max_yt + max_zt);
     let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = Vec3::new(e0, e1, e2).abs().max_element();
-    let delta_t =
-        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
     if t <= delta_t || !t.is_finite() {
         return None;
     }
     let weighted = [p0 * b0, p1 * b1, p2 * b2];
     let point = weighted[0] + weighted[1] + weighted[2];
-    let error =
-        gamma(7) * (weighted[0].abs() + weighted[1].abs() + weighted[2].abs()).max_element();
-    Some(SurfaceHit {
-        t,
-        point,
-        normal: triangle.normal,
-        error,
-    })
+    let error = gamma(7) * (weighted[0].abs() + weighted[1].abs() + weighted[2].abs()).max_element();
+    Some(SurfaceHit { t, point, normal: triangle.normal, error })
 }
 
 #[cfg(test)]
@@ -127,47 +113,22 @@ mod tests {
 
     #[test]
     fn hits_inside_and_misses_outside() {
-        let tri = Triangle::new(
-            Vec3::new(-1.0, -1.0, 0.0),
-            Vec3::new(1.0, -1.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-        );
-        let hit = intersect_triangle(
-            &Ray::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::Z),
-            &tri,
-            f32::INFINITY,
-        )
-        .unwrap();
+        let tri = Triangle::new(Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0));
+        let hit = intersect_triangle(&Ray::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::Z), &tri, f32::INFINITY).unwrap();
         assert!((hit.t - 2.0).abs() < 1e-6);
         assert_eq!(hit.normal, Vec3::Z);
-        assert!(intersect_triangle(
-            &Ray::new(Vec3::new(2.0, 0.0, 2.0), -Vec3::Z),
-            &tri,
-            f32::INFINITY
-        )
-        .is_none());
-        assert!(
-            intersect_triangle(&Ray::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::Z), &tri, 1.0).is_none()
-        );
+        assert!(intersect_triangle(&Ray::new(Vec3::new(2.0, 0.0, 2.0), -Vec3::Z), &tri, f32::INFINITY).is_none());
+        assert!(intersect_triangle(&Ray::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::Z), &tri, 1.0).is_none());
     }
 
     #[test]
     fn degenerate_triangles_never_hit() {
         let collinear = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
         let point = Triangle::new(Vec3::ONE, Vec3::ONE, Vec3::ONE);
-        let far = Triangle::new(
-            Vec3::splat(1e7),
-            Vec3::splat(1e7) + Vec3::X,
-            Vec3::splat(1e7) + Vec3::X * 2.0,
-        );
+        let far = Triangle::new(Vec3::splat(1e7), Vec3::splat(1e7) + Vec3::X, Vec3::splat(1e7) + Vec3::X * 2.0);
         for tri in [collinear, point, far] {
             assert!(tri.is_degenerate());
-            for dir in [
-                Vec3::Z,
-                -Vec3::Z,
-                Vec3::X,
-                Vec3::new(0.3, 0.4, -0.5).normalize(),
-            ] {
+            for dir in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(0.3, 0.4, -0.5).normalize()] {
                 let ray = Ray::new(Vec3::new(0.5, 0.0, 1.0), dir);
                 assert!(intersect_triangle(&ray, &tri, f32::INFINITY).is_none());
             }
@@ -184,14 +145,9 @@ mod tests {
         for i in 0..1000 {
             // Interior of the shared diagonal (its ends are the square's corners)
             let s = i as f32 / 999.0 * 1.98 - 0.99;
-            let ray = Ray::new(
-                Vec3::new(s, s, 1.0) + Vec3::new(0.1, -0.2, 0.0),
-                Vec3::new(-0.1, 0.2, -1.0).normalize(),
-            );
-            let hits = [&t0, &t1]
-                .iter()
-                .filter(|t| intersect_triangle(&ray, t, f32::INFINITY).is_some())
-                .count();
+            let ray =
+                Ray::new(Vec3::new(s, s, 1.0) + Vec3::new(0.1, -0.2, 0.0), Vec3::new(-0.1, 0.2, -1.0).normalize());
+            let hits = [&t0, &t1].iter().filter(|t| intersect_triangle(&ray, t, f32::INFINITY).is_some()).count();
             assert!(hits >= 1, "ray {i} fell through the diagonal");
         }
     }

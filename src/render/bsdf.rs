@@ -58,11 +58,7 @@ pub fn refract(wo: Vec3, n: Vec3, eta_i: f32, eta_t: f32) -> (f32, Option<Vec3>,
     }
     let cos_t = (1.0 - sin2_t).sqrt();
     let fresnel = fresnel_dielectric(cos_i, cos_t, eta_i, eta_t);
-    (
-        fresnel,
-        Some((-eta * wo + (eta * cos_i - cos_t) * n).normalize()),
-        eta,
-    )
+    (fresnel, Some((-eta * wo + (eta * cos_i - cos_t) * n).normalize()), eta)
 }
 
 /// Exact normalisation of the Blinn–Phong lobe at normal incidence
@@ -104,20 +100,8 @@ impl Bsdf {
     pub fn new(material: &MaterialModel) -> Self {
         match *material {
             MaterialModel::Lambert { albedo } => Bsdf::Lambert { albedo },
-            MaterialModel::Phong {
-                kd, ks, shininess, ..
-            } => Bsdf::Phong {
-                kd,
-                ks,
-                exponent: shininess,
-            },
-            MaterialModel::BlinnPhong {
-                kd, ks, shininess, ..
-            } => Bsdf::BlinnPhong {
-                kd,
-                ks,
-                exponent: shininess,
-            },
+            MaterialModel::Phong { kd, ks, shininess, .. } => Bsdf::Phong { kd, ks, exponent: shininess },
+            MaterialModel::BlinnPhong { kd, ks, shininess, .. } => Bsdf::BlinnPhong { kd, ks, exponent: shininess },
             MaterialModel::Mirror { tint } => Bsdf::Mirror { tint },
             MaterialModel::Glass { ior, tint } => Bsdf::Glass { ior, tint },
             MaterialModel::Emissive { .. } => Bsdf::Black,
@@ -151,13 +135,11 @@ impl Bsdf {
             Bsdf::Lambert { albedo } => albedo * FRAC_1_PI,
             Bsdf::Phong { kd, ks, exponent } => {
                 let cos_alpha = reflect(wo, n).dot(wi).max(0.0);
-                kd * FRAC_1_PI
-                    + ks * ((exponent + 2.0) * 0.5 * FRAC_1_PI * cos_alpha.powf(exponent))
+                kd * FRAC_1_PI + ks * ((exponent + 2.0) * 0.5 * FRAC_1_PI * cos_alpha.powf(exponent))
             }
             Bsdf::BlinnPhong { kd, ks, exponent } => {
                 let h = (wo + wi).normalize();
-                kd * FRAC_1_PI
-                    + ks * (blinn_normalisation(exponent) * n.dot(h).max(0.0).powf(exponent))
+                kd * FRAC_1_PI + ks * (blinn_normalisation(exponent) * n.dot(h).max(0.0).powf(exponent))
             }
             Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::Black => Rgb::ZERO,
         }
@@ -173,8 +155,7 @@ impl Bsdf {
             Bsdf::Lambert { .. } => cosine_hemisphere_pdf(wi.dot(n)),
             Bsdf::Phong { kd, ks, exponent } => {
                 let pd = Self::diffuse_probability(kd, ks);
-                pd * cosine_hemisphere_pdf(wi.dot(n))
-                    + (1.0 - pd) * power_cosine_pdf(reflect(wo, n).dot(wi), exponent)
+                pd * cosine_hemisphere_pdf(wi.dot(n)) + (1.0 - pd) * power_cosine_pdf(reflect(wo, n).dot(wi), exponent)
             }
             Bsdf::BlinnPhong { kd, ks, exponent } => {
                 let pd = Self::diffuse_probability(kd, ks);
@@ -190,14 +171,7 @@ impl Bsdf {
     /// opaque models flip it to `wo`'s side, glass uses it to tell entering
     /// from leaving.
     #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3,
-        n: Vec3,
-        u_lobe: f32,
-        u: Vec2,
-        transport: Transport,
-    ) -> Option<BsdfSample> {
+    pub fn sample(&self, wo: Vec3, n: Vec3, u_lobe: f32, u: Vec2, transport: Transport) -> Option<BsdfSample> {
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
         let scattered = |wi: Vec3| -> Option<BsdfSample> {
             let pdf = self.pdf(wo, wi, facing);
@@ -205,23 +179,13 @@ impl Bsdf {
                 return None;
             }
             let weight = self.eval(wo, wi, facing) * (wi.dot(facing) / pdf);
-            Some(BsdfSample {
-                wi,
-                weight,
-                pdf,
-                delta: false,
-            })
+            Some(BsdfSample { wi, weight, pdf, delta: false })
         };
         match *self {
             Bsdf::Lambert { albedo } => {
                 let wi = Frame::from_z(facing).to_world(cosine_hemisphere(u));
                 let cos = wi.dot(facing);
-                (cos > 0.0).then(|| BsdfSample {
-                    wi,
-                    weight: albedo,
-                    pdf: cosine_hemisphere_pdf(cos),
-                    delta: false,
-                })
+                (cos > 0.0).then(|| BsdfSample { wi, weight: albedo, pdf: cosine_hemisphere_pdf(cos), delta: false })
             }
             Bsdf::Phong { kd, ks, exponent } => {
                 let wi = if u_lobe < Self::diffuse_probability(kd, ks) {
@@ -240,36 +204,17 @@ impl Bsdf {
                 };
                 scattered(wi)
             }
-            Bsdf::Mirror { tint } => Some(BsdfSample {
-                wi: reflect(wo, facing),
-                weight: tint,
-                pdf: 1.0,
-                delta: true,
-            }),
+            Bsdf::Mirror { tint } => Some(BsdfSample { wi: reflect(wo, facing), weight: tint, pdf: 1.0, delta: true }),
             Bsdf::Glass { ior, tint } => {
                 let entering = wo.dot(n) > 0.0;
                 let (eta_i, eta_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
                 let (fresnel, refracted, eta) = refract(wo, facing, eta_i, eta_t);
                 match refracted {
                     Some(wt) if u_lobe >= fresnel => {
-                        let scale = if transport == Transport::Radiance {
-                            eta * eta
-                        } else {
-                            1.0
-                        };
-                        Some(BsdfSample {
-                            wi: wt,
-                            weight: tint * scale,
-                            pdf: 1.0 - fresnel,
-                            delta: true,
-                        })
+                        let scale = if transport == Transport::Radiance { eta * eta } else { 1.0 };
+                        Some(BsdfSample { wi: wt, weight: tint * scale, pdf: 1.0 - fresnel, delta: true })
                     }
-                    _ => Some(BsdfSample {
-                        wi: reflect(wo, facing),
-                        weight: tint,
-                        pdf: fresnel,
-                        delta: true,
-                    }),
+                    _ => Some(BsdfSample { wi: reflect(wo, facing), weight: tint, pdf: fresnel, delta: true }),
                 }
             }
             Bsdf::Black => None,
@@ -286,9 +231,7 @@ mod tests {
         let mut s = Sampler::new(0, 0, 5);
         let mut sum = Rgb::ZERO;
         for _ in 0..n {
-            if let Some(b) =
-                bsdf.sample(wo, Vec3::Z, s.next_f32(), s.next_2d(), Transport::Radiance)
-            {
+            if let Some(b) = bsdf.sample(wo, Vec3::Z, s.next_f32(), s.next_2d(), Transport::Radiance) {
                 sum += b.weight;
             }
         }
@@ -298,30 +241,16 @@ mod tests {
     #[test]
     fn sampled_weight_matches_eval_over_pdf() {
         let bsdfs = [
-            Bsdf::Phong {
-                kd: Vec3::splat(0.3),
-                ks: Vec3::splat(0.6),
-                exponent: 20.0,
-            },
-            Bsdf::BlinnPhong {
-                kd: Vec3::splat(0.2),
-                ks: Vec3::splat(0.7),
-                exponent: 50.0,
-            },
+            Bsdf::Phong { kd: Vec3::splat(0.3), ks: Vec3::splat(0.6), exponent: 20.0 },
+            Bsdf::BlinnPhong { kd: Vec3::splat(0.2), ks: Vec3::splat(0.7), exponent: 50.0 },
         ];
         let wo = Vec3::new(0.3, 0.1, 0.9).normalize();
         let mut s = Sampler::new(1, 1, 1);
         for bsdf in bsdfs {
             for _ in 0..1000 {
-                if let Some(b) =
-                    bsdf.sample(wo, Vec3::Z, s.next_f32(), s.next_2d(), Transport::Radiance)
-                {
-                    let expected =
-                        bsdf.eval(wo, b.wi, Vec3::Z) * b.wi.z / bsdf.pdf(wo, b.wi, Vec3::Z);
-                    assert!(
-                        (expected - b.weight).abs().max_element()
-                            < 1e-3 * (1.0 + expected.max_element())
-                    );
+                if let Some(b) = bsdf.sample(wo, Vec3::Z, s.next_f32(), s.next_2d(), Transport::Radiance) {
+                    let expected = bsdf.eval(wo, b.wi, Vec3::Z) * b.wi.z / bsdf.pdf(wo, b.wi, Vec3::Z);
+                    assert!((expected - b.weight).abs().max_element() < 1e-3 * (1.0 + expected.max_element()));
                 }
             }
         }
@@ -329,13 +258,7 @@ mod tests {
 
     #[test]
     fn lambert_albedo_is_exact() {
-        let a = directional_albedo(
-            &Bsdf::Lambert {
-                albedo: Vec3::splat(0.5),
-            },
-            Vec3::Z,
-            1000,
-        );
+        let a = directional_albedo(&Bsdf::Lambert { albedo: Vec3::splat(0.5) }, Vec3::Z, 1000);
         assert!((a - Vec3::splat(0.5)).abs().max_element() < 1e-6);
     }
 

@@ -71,10 +71,7 @@ impl CameraModel {
 
     /// The ray through the centre of pixel (x, y), for picking.
     pub fn pixel_ray(&self, x: f32, y: f32) -> Ray {
-        let saved = Self {
-            aperture_radius: 0.0,
-            ..self.clone()
-        };
+        let saved = Self { aperture_radius: 0.0, ..self.clone() };
         saved.generate_ray(Vec2::new(x, y), Vec2::splat(0.5))
     }
 }

@@ -66,25 +66,11 @@ pub struct TileUpdate {
 /// job) it belongs to, so stale ones can be dropped.
 #[derive(Clone, Debug)]
 pub enum RenderEvent {
-    Started {
-        generation: u64,
-        width: u32,
-        height: u32,
-    },
+    Started { generation: u64, width: u32, height: u32 },
     Tile(TileUpdate),
-    PassFinished {
-        generation: u64,
-        stats: PassStats,
-    },
-    Finished {
-        generation: u64,
-        image: Arc<LinearImage>,
-        stats: PassStats,
-    },
-    Failed {
-        generation: u64,
-        message: String,
-    },
+    PassFinished { generation: u64, stats: PassStats },
+    Finished { generation: u64, image: Arc<LinearImage>, stats: PassStats },
+    Failed { generation: u64, message: String },
 }
 
 impl RenderEvent {
@@ -132,12 +118,7 @@ impl RenderSession {
             .name("render-worker".into())
             .spawn(move || worker_loop(command_rx, event_tx, worker_generation, notify))
             .ok();
-        Self {
-            commands,
-            events,
-            generation,
-            worker,
-        }
+        Self { commands, events, generation, worker }
     }
 
     /// Start rendering `job`, abandoning whatever was in flight. Returns the
@@ -195,10 +176,7 @@ fn worker_loop(
             match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
                 Ok(pool) => pools = Some((threads, pool)),
                 Err(e) => {
-                    let _ = events.send(RenderEvent::Failed {
-                        generation: job_generation,
-                        message: e.to_string(),
-                    });
+                    let _ = events.send(RenderEvent::Failed { generation: job_generation, message: e.to_string() });
                     continue;
                 }
             }
@@ -243,17 +221,11 @@ fn run_job(context: &JobContext, job: &RenderJob) {
     let settings = &job.settings;
     let generation = context.generation;
     if let Some(problem) = job.scene.validate().into_iter().next() {
-        context.send(RenderEvent::Failed {
-            generation,
-            message: problem.to_string(),
-        });
+        context.send(RenderEvent::Failed { generation, message: problem.to_string() });
         return;
     }
     if settings.width == 0 || settings.height == 0 {
-        context.send(RenderEvent::Failed {
-            generation,
-            message: "image size must be at least 1×1".into(),
-        });
+        context.send(RenderEvent::Failed { generation, message: "image size must be at least 1×1".into() });
         return;
     }
     let frame = FrameContext {
@@ -261,11 +233,7 @@ fn run_job(context: &JobContext, job: &RenderJob) {
         camera: CameraModel::new(&job.scene.camera, settings.width, settings.height),
         settings,
     };
-    context.send(RenderEvent::Started {
-        generation,
-        width: settings.width,
-        height: settings.height,
-    });
+    context.send(RenderEvent::Started { generation, width: settings.width, height: settings.height });
     let start = Instant::now();
     let tiles = tile_layout(settings.width, settings.height, settings.tile_size);
 
@@ -273,28 +241,19 @@ fn run_job(context: &JobContext, job: &RenderJob) {
         tiles.par_iter().for_each(|rect| {
             if context.is_current() {
                 let pixels = frame.preview_tile(*rect);
-                context.send(RenderEvent::Tile(TileUpdate {
-                    generation,
-                    rect: *rect,
-                    pixels,
-                    preview: true,
-                }));
+                context.send(RenderEvent::Tile(TileUpdate { generation, rect: *rect, pixels, preview: true }));
             }
         });
     }
 
-    let mut buffers: Vec<TileAccumulator> =
-        tiles.iter().map(|r| TileAccumulator::new(*r)).collect();
+    let mut buffers: Vec<TileAccumulator> = tiles.iter().map(|r| TileAccumulator::new(*r)).collect();
     let rays = AtomicU64::new(0);
     let non_finite = AtomicU64::new(0);
     let mut stats = PassStats::default();
     loop {
-        let done_spp = settings
-            .samples_per_pixel
-            .is_some_and(|spp| stats.passes >= spp);
-        let done_time = settings
-            .time_limit
-            .is_some_and(|limit| stats.passes > 0 && start.elapsed().as_secs_f64() >= limit);
+        let done_spp = settings.samples_per_pixel.is_some_and(|spp| stats.passes >= spp);
+        let done_time =
+            settings.time_limit.is_some_and(|limit| stats.passes > 0 && start.elapsed().as_secs_f64() >= limit);
         if done_spp || done_time {
             break;
         }
@@ -309,12 +268,7 @@ fn run_job(context: &JobContext, job: &RenderJob) {
             rays.fetch_add(counters.rays, Ordering::Relaxed);
             non_finite.fetch_add(counters.non_finite, Ordering::Relaxed);
             let pixels = buffer.mean();
-            context.send(RenderEvent::Tile(TileUpdate {
-                generation,
-                rect: buffer.rect,
-                pixels,
-                preview: false,
-            }));
+            context.send(RenderEvent::Tile(TileUpdate { generation, rect: buffer.rect, pixels, preview: false }));
         });
         if !context.is_current() {
             return;
@@ -328,11 +282,7 @@ fn run_job(context: &JobContext, job: &RenderJob) {
         context.send(RenderEvent::PassFinished { generation, stats });
     }
     let image = assemble(settings.width, settings.height, &buffers);
-    context.send(RenderEvent::Finished {
-        generation,
-        image: Arc::new(image),
-        stats,
-    });
+    context.send(RenderEvent::Finished { generation, image: Arc::new(image), stats });
 }
 
 fn assemble(width: u32, height: u32, buffers: &[TileAccumulator]) -> LinearImage {
@@ -340,10 +290,7 @@ fn assemble(width: u32, height: u32, buffers: &[TileAccumulator]) -> LinearImage
     for buffer in buffers {
         let rect = buffer.rect;
         for (i, pixel) in buffer.mean().into_iter().enumerate() {
-            let (x, y) = (
-                rect.x + i as u32 % rect.width,
-                rect.y + i as u32 / rect.width,
-            );
+            let (x, y) = (rect.x + i as u32 % rect.width, rect.y + i as u32 / rect.width);
             image.pixels[(y * width + x) as usize] = pixel;
         }
     }
@@ -367,41 +314,26 @@ impl FrameContext<'_> {
         let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
         let ray = self.camera.generate_ray(film, sampler.next_2d());
         let value = match settings.algorithm {
-            Algorithm::Whitted => whitted::radiance(
-                &self.world,
-                &ray,
-                settings.max_depth.max(1),
-                1.0,
-                &mut sampler,
-                counters,
-            ),
-            Algorithm::Path | Algorithm::Photon | Algorithm::Sppm => path::radiance(
-                &self.world,
-                &ray,
-                settings.max_depth,
-                &mut sampler,
-                counters,
-            ),
+            Algorithm::Whitted => {
+                whitted::radiance(&self.world, &ray, settings.max_depth.max(1), 1.0, &mut sampler, counters)
+            }
+            Algorithm::Path | Algorithm::Photon | Algorithm::Sppm => {
+                path::radiance(&self.world, &ray, settings.max_depth, &mut sampler, counters)
+            }
         };
         if !value.is_finite() {
             counters.non_finite += 1;
             return None;
         }
         let value = value.max(Rgb::ZERO);
-        Some(if settings.firefly_clamp > 0.0 {
-            value.min(Rgb::splat(settings.firefly_clamp))
-        } else {
-            value
-        })
+        Some(if settings.firefly_clamp > 0.0 { value.min(Rgb::splat(settings.firefly_clamp)) } else { value })
     }
 
     fn render_tile_pass(&self, buffer: &mut TileAccumulator, pass: u32, counters: &mut Counters) {
         let rect = buffer.rect;
         for row in 0..rect.height {
             for column in 0..rect.width {
-                let value = self
-                    .sample(rect.x + column, rect.y + row, pass as u64, counters)
-                    .unwrap_or(Rgb::ZERO);
+                let value = self.sample(rect.x + column, rect.y + row, pass as u64, counters).unwrap_or(Rgb::ZERO);
                 let sum = &mut buffer.sums[(row * rect.width + column) as usize];
                 for c in 0..3 {
                     sum[c] += value[c] as f64;
@@ -417,17 +349,9 @@ impl FrameContext<'_> {
         let mut counters = Counters::default();
         for by in (0..rect.height).step_by(PREVIEW_BLOCK as usize) {
             for bx in (0..rect.width).step_by(PREVIEW_BLOCK as usize) {
-                let (w, h) = (
-                    PREVIEW_BLOCK.min(rect.width - bx),
-                    PREVIEW_BLOCK.min(rect.height - by),
-                );
+                let (w, h) = (PREVIEW_BLOCK.min(rect.width - bx), PREVIEW_BLOCK.min(rect.height - by));
                 let value = self
-                    .sample(
-                        rect.x + bx + w / 2,
-                        rect.y + by + h / 2,
-                        PREVIEW_SAMPLE,
-                        &mut counters,
-                    )
+                    .sample(rect.x + bx + w / 2, rect.y + by + h / 2, PREVIEW_SAMPLE, &mut counters)
                     .unwrap_or(Rgb::ZERO);
                 for y in by..by + h {
                     for x in bx..bx + w {
@@ -447,20 +371,10 @@ pub fn render_blocking(job: &RenderJob) -> Result<(LinearImage, PassStats), Stri
     let generation = session.start(job.clone());
     for event in session.events().iter() {
         match event {
-            RenderEvent::Finished {
-                generation: g,
-                image,
-                stats,
-            } if g == generation => {
-                return Ok((
-                    Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone()),
-                    stats,
-                ));
+            RenderEvent::Finished { generation: g, image, stats } if g == generation => {
+                return Ok((Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone()), stats));
             }
-            RenderEvent::Failed {
-                generation: g,
-                message,
-            } if g == generation => return Err(message),
+            RenderEvent::Failed { generation: g, message } if g == generation => return Err(message),
             _ => {}
         }
     }

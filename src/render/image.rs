@@ -15,15 +15,9 @@ pub enum ImageError {
     #[error("{path}: unsupported image extension (use .png or .exr)")]
     UnknownFormat { path: String },
     #[error("{path}: {source}")]
-    Write {
-        path: String,
-        source: image::ImageError,
-    },
+    Write { path: String, source: image::ImageError },
     #[error("{path}: {source}")]
-    Read {
-        path: String,
-        source: image::ImageError,
-    },
+    Read { path: String, source: image::ImageError },
 }
 
 /// sRGB opto-electronic transfer function on [0, 1].
@@ -52,11 +46,7 @@ pub fn tonemap_srgb8(linear: [f32; 3], exposure_stops: f32) -> [u8; 3] {
 
 impl LinearImage {
     pub fn new(width: u32, height: u32) -> Self {
-        Self {
-            width,
-            height,
-            pixels: vec![[0.0; 3]; width as usize * height as usize],
-        }
+        Self { width, height, pixels: vec![[0.0; 3]; width as usize * height as usize] }
     }
 
     #[inline]
@@ -88,24 +78,11 @@ impl LinearImage {
     /// `.png`: tone-mapped sRGB 8-bit; `.exr`: linear 32-bit float.
     pub fn save(&self, path: &Path, exposure_stops: f32) -> Result<(), ImageError> {
         let name = path.display().to_string();
-        let extension = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
+        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         let result = match extension.as_deref() {
             Some("png") => {
-                let rgb: Vec<u8> = self
-                    .pixels
-                    .iter()
-                    .flat_map(|p| tonemap_srgb8(*p, exposure_stops))
-                    .collect();
-                image::save_buffer(
-                    path,
-                    &rgb,
-                    self.width,
-                    self.height,
-                    image::ExtendedColorType::Rgb8,
-                )
+                let rgb: Vec<u8> = self.pixels.iter().flat_map(|p| tonemap_srgb8(*p, exposure_stops)).collect();
+                image::save_buffer(path, &rgb, self.width, self.height, image::ExtendedColorType::Rgb8)
             }
             Some("exr") => {
                 let data: Vec<f32> = self.pixels.iter().flatten().copied().collect();
@@ -122,22 +99,12 @@ impl LinearImage {
     /// Load a linear EXR (references) or an 8-bit image decoded from sRGB.
     pub fn load(path: &Path) -> Result<Self, ImageError> {
         let name = path.display().to_string();
-        let decoded =
-            image::open(path).map_err(|source| ImageError::Read { path: name, source })?;
-        let is_exr = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        let decoded = image::open(path).map_err(|source| ImageError::Read { path: name, source })?;
+        let is_exr = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
         let rgb = decoded.to_rgb32f();
         let (width, height) = rgb.dimensions();
-        let pixels = rgb
-            .pixels()
-            .map(|p| if is_exr { p.0 } else { p.0.map(srgb_decode) })
-            .collect();
-        Ok(Self {
-            width,
-            height,
-            pixels,
-        })
+        let pixels = rgb.pixels().map(|p| if is_exr { p.0 } else { p.0.map(srgb_decode) }).collect();
+        Ok(Self { width, height, pixels })
     }
 }
 
@@ -151,11 +118,9 @@ fn srgb_decode(v: f32) -> f32 {
 
 // The buffer is built from width × height pixels above, so the size always fits.
 fn unreachable_size() -> image::ImageResult<()> {
-    Err(image::ImageError::Parameter(
-        image::error::ParameterError::from_kind(
-            image::error::ParameterErrorKind::DimensionMismatch,
-        ),
-    ))
+    Err(image::ImageError::Parameter(image::error::ParameterError::from_kind(
+        image::error::ParameterErrorKind::DimensionMismatch,
+    )))
 }
 
 #[cfg(test)]
@@ -180,9 +145,6 @@ mod tests {
         img.save(&dir.join("a.png"), 0.0).unwrap();
         let png = LinearImage::load(&dir.join("a.png")).unwrap();
         assert_eq!((png.width, png.height), (3, 2));
-        assert!(matches!(
-            img.save(&dir.join("a.bmpx"), 0.0),
-            Err(ImageError::UnknownFormat { .. })
-        ));
+        assert!(matches!(img.save(&dir.join("a.bmpx"), 0.0), Err(ImageError::UnknownFormat { .. })));
     }
 }

@@ -72,30 +72,13 @@ impl LightSource {
     pub fn sample(&self, world: &World, at: &SurfaceHit, u: Vec2) -> Option<LightSample> {
         let p = at.point;
         match *self {
-            LightSource::Point {
-                position,
-                intensity,
-                attenuation,
-            } => {
+            LightSource::Point { position, intensity, attenuation } => {
                 let (shadow, shadow_t_max) = at.spawn_ray_to(position, 0.0);
                 let d = (position - p).length();
                 let value = intensity * attenuation.factor(d);
-                Some(LightSample {
-                    wi: shadow.direction,
-                    value,
-                    pdf: f32::INFINITY,
-                    shadow,
-                    shadow_t_max,
-                })
+                Some(LightSample { wi: shadow.direction, value, pdf: f32::INFINITY, shadow, shadow_t_max })
             }
-            LightSource::Spot {
-                position,
-                direction,
-                cos_cone,
-                exponent,
-                intensity,
-                attenuation,
-            } => {
+            LightSource::Spot { position, direction, cos_cone, exponent, intensity, attenuation } => {
                 let (shadow, shadow_t_max) = at.spawn_ray_to(position, 0.0);
                 let d = (position - p).length();
                 let factor = spot_factor(direction, -shadow.direction, cos_cone, exponent);
@@ -103,18 +86,9 @@ impl LightSource {
                     return None;
                 }
                 let value = intensity * (attenuation.factor(d) * factor);
-                Some(LightSample {
-                    wi: shadow.direction,
-                    value,
-                    pdf: f32::INFINITY,
-                    shadow,
-                    shadow_t_max,
-                })
+                Some(LightSample { wi: shadow.direction, value, pdf: f32::INFINITY, shadow, shadow_t_max })
             }
-            LightSource::Directional {
-                direction,
-                irradiance,
-            } => {
+            LightSource::Directional { direction, irradiance } => {
                 let shadow = at.spawn_ray(-direction);
                 Some(LightSample {
                     wi: -direction,
@@ -131,13 +105,7 @@ impl LightSource {
                 if normal.dot(-shadow.direction) <= 0.0 || !(pdf > 0.0) {
                     return None;
                 }
-                Some(LightSample {
-                    wi: shadow.direction,
-                    value: radiance / pdf,
-                    pdf,
-                    shadow,
-                    shadow_t_max,
-                })
+                Some(LightSample { wi: shadow.direction, value: radiance / pdf, pdf, shadow, shadow_t_max })
             }
         }
     }
@@ -176,12 +144,7 @@ fn sample_area(world: &World, object: u32, p: Vec3, u: Vec2) -> Option<(Vec3, Ve
                     }
                 }
             };
-            Some((
-                hit.point,
-                hit.normal,
-                hit.error,
-                uniform_cone_pdf(one_minus_cos),
-            ))
+            Some((hit.point, hit.normal, hit.error, uniform_cone_pdf(one_minus_cos)))
         }
         ShapeRef::Triangle(t) => {
             let triangle = &world.triangles[t as usize].0;
@@ -195,12 +158,7 @@ fn sample_area(world: &World, object: u32, p: Vec3, u: Vec2) -> Option<(Vec3, Ve
                 return None;
             }
             let error = crate::geometry::gamma(7) * (a.abs() + b.abs() + c.abs()).max_element();
-            Some((
-                point,
-                triangle.normal,
-                error,
-                distance2 / (cos_light * triangle.area()),
-            ))
+            Some((point, triangle.normal, error, distance2 / (cos_light * triangle.area())))
         }
         ShapeRef::Plane(_) => None,
     }
@@ -247,9 +205,7 @@ mod tests {
         let outside = Vec3::new((cone + 1e-3).sin(), -(cone + 1e-3).cos(), 0.0);
         assert!(spot_factor(axis, inside, cone.cos(), 0.0) == 1.0);
         assert!(spot_factor(axis, outside, cone.cos(), 0.0) == 0.0);
-        assert!(
-            (spot_factor(axis, inside, cone.cos(), 2.0) - (cone - 1e-3).cos().powi(2)).abs() < 1e-6
-        );
+        assert!((spot_factor(axis, inside, cone.cos(), 2.0) - (cone - 1e-3).cos().powi(2)).abs() < 1e-6);
         assert_eq!(spot_factor(axis, axis, 1.0, 1.0e4), 1.0);
     }
 }

@@ -14,13 +14,7 @@ use crate::scene::Rgb;
 /// Bounces before Russian roulette may end a path.
 const ROULETTE_DEPTH: u32 = 3;
 
-pub fn radiance(
-    world: &World,
-    ray: &Ray,
-    max_depth: u32,
-    sampler: &mut Sampler,
-    counters: &mut Counters,
-) -> Rgb {
+pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
     let mut ray = *ray;
     let mut radiance = Rgb::ZERO;
     let mut throughput = Rgb::ONE;
@@ -43,10 +37,9 @@ pub fn radiance(
         let emitted = world.emitted(&hit, wo);
         if emitted != Rgb::ZERO {
             let weight = match world.objects[hit.object as usize].light {
-                Some(_) if !after_delta => power_heuristic(
-                    last_pdf,
-                    pick_pdf * area_pdf(world, hit.object, last_point, &hit.surface),
-                ),
+                Some(_) if !after_delta => {
+                    power_heuristic(last_pdf, pick_pdf * area_pdf(world, hit.object, last_point, &hit.surface))
+                }
                 _ => 1.0,
             };
             radiance += throughput * emitted * weight;
@@ -70,22 +63,13 @@ pub fn radiance(
                         } else {
                             power_heuristic(pick_pdf * sample.pdf, bsdf.pdf(wo, sample.wi, facing))
                         };
-                        radiance += throughput
-                            * f
-                            * sample.value
-                            * (sample.wi.dot(facing) * weight / pick_pdf);
+                        radiance += throughput * f * sample.value * (sample.wi.dot(facing) * weight / pick_pdf);
                     }
                 }
             }
         }
 
-        let Some(scattered) = bsdf.sample(
-            wo,
-            n,
-            sampler.next_f32(),
-            sampler.next_2d(),
-            Transport::Radiance,
-        ) else {
+        let Some(scattered) = bsdf.sample(wo, n, sampler.next_f32(), sampler.next_2d(), Transport::Radiance) else {
             break;
         };
         throughput *= scattered.weight;

@@ -22,10 +22,7 @@ impl Sampler {
     #[inline]
     pub fn new(index: u64, sample: u64, seed: u64) -> Self {
         let state = mix64(
-            seed ^ mix64(
-                index.wrapping_mul(0x9e37_79b9_7f4a_7c15)
-                    ^ mix64(sample.wrapping_add(0x632b_e59b_d9b4_e019)),
-            ),
+            seed ^ mix64(index.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ mix64(sample.wrapping_add(0x632b_e59b_d9b4_e019))),
         );
         Self { state }
     }

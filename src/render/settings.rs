@@ -14,12 +14,7 @@ pub enum Algorithm {
 }
 
 impl Algorithm {
-    pub const ALL: [Algorithm; 4] = [
-        Algorithm::Whitted,
-        Algorithm::Path,
-        Algorithm::Photon,
-        Algorithm::Sppm,
-    ];
+    pub const ALL: [Algorithm; 4] = [Algorithm::Whitted, Algorithm::Path, Algorithm::Photon, Algorithm::Sppm];
 
     /// The name used on the command line and in files.
     pub fn name(self) -> &'static str {
@@ -62,9 +57,7 @@ impl FromStr for Algorithm {
         Algorithm::ALL
             .into_iter()
             .find(|a| a.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| {
-                format!("unknown algorithm \"{s}\" (expected whitted, path, photon or sppm)")
-            })
+            .ok_or_else(|| format!("unknown algorithm \"{s}\" (expected whitted, path, photon or sppm)"))
     }
 }
 
@@ -147,10 +140,6 @@ impl Default for RenderSettings {
 
 impl RenderSettings {
     pub fn for_algorithm(algorithm: Algorithm) -> Self {
-        Self {
-            algorithm,
-            max_depth: algorithm.default_max_depth(),
-            ..Self::default()
-        }
+        Self { algorithm, max_depth: algorithm.default_max_depth(), ..Self::default() }
     }
 }

@@ -16,12 +16,7 @@ pub fn tile_layout(width: u32, height: u32, tile_size: u32) -> Vec<TileRect> {
     let mut tiles = Vec::new();
     for y in (0..height).step_by(size as usize) {
         for x in (0..width).step_by(size as usize) {
-            tiles.push(TileRect {
-                x,
-                y,
-                width: size.min(width - x),
-                height: size.min(height - y),
-            });
+            tiles.push(TileRect { x, y, width: size.min(width - x), height: size.min(height - y) });
         }
     }
     let (cx, cy) = (width as f32 * 0.5, height as f32 * 0.5);
@@ -46,19 +41,12 @@ pub struct TileAccumulator {
 
 impl TileAccumulator {
     pub fn new(rect: TileRect) -> Self {
-        Self {
-            rect,
-            sums: vec![[0.0; 3]; (rect.width * rect.height) as usize],
-            samples: 0,
-        }
+        Self { rect, sums: vec![[0.0; 3]; (rect.width * rect.height) as usize], samples: 0 }
     }
 
     pub fn mean(&self) -> Vec<[f32; 3]> {
         let scale = 1.0 / self.samples.max(1) as f64;
-        self.sums
-            .iter()
-            .map(|s| s.map(|c| (c * scale) as f32))
-            .collect()
+        self.sums.iter().map(|s| s.map(|c| (c * scale) as f32)).collect()
     }
 }
 
@@ -80,11 +68,6 @@ mod tests {
         }
         assert!(covered.iter().all(|c| *c == 1));
         let first = tiles[0];
-        assert!(
-            first.x <= 50
-                && 50 < first.x + first.width
-                && first.y <= 35
-                && 35 < first.y + first.height
-        );
+        assert!(first.x <= 50 && 50 < first.x + first.width && first.y <= 35 && 35 < first.y + first.height);
     }
 }

@@ -39,37 +39,12 @@ pub fn radiance(
     match *world.material_of(&hit) {
         MaterialModel::Emissive { .. } => world.emitted(&hit, wo),
         MaterialModel::Lambert { albedo } => {
-            albedo * world.ambient
-                + local(
-                    world,
-                    &hit,
-                    facing,
-                    wo,
-                    albedo,
-                    Rgb::ZERO,
-                    0.0,
-                    false,
-                    sampler,
-                    counters,
-                )
+            albedo * world.ambient + local(world, &hit, facing, wo, albedo, Rgb::ZERO, 0.0, false, sampler, counters)
         }
-        MaterialModel::Phong {
-            ka,
-            kd,
-            ks,
-            shininess,
-        }
-        | MaterialModel::BlinnPhong {
-            ka,
-            kd,
-            ks,
-            shininess,
-        } => {
+        MaterialModel::Phong { ka, kd, ks, shininess } | MaterialModel::BlinnPhong { ka, kd, ks, shininess } => {
             let blinn = matches!(world.material_of(&hit), MaterialModel::BlinnPhong { .. });
-            let mut c = ka * world.ambient
-                + local(
-                    world, &hit, facing, wo, kd, ks, shininess, blinn, sampler, counters,
-                );
+            let mut c =
+                ka * world.ambient + local(world, &hit, facing, wo, kd, ks, shininess, blinn, sampler, counters);
             // The thesis' loop: the surface's reflectivity scales a mirror bounce
             let w = weight * ks.max_element();
             if can_recurse && w > MIN_WEIGHT {
@@ -90,24 +65,13 @@ pub fn radiance(
             if !can_recurse || w <= MIN_WEIGHT {
                 return Rgb::ZERO;
             }
-            tint * radiance(
-                world,
-                &hit.surface.spawn_ray(reflect(wo, facing)),
-                depth_left - 1,
-                w,
-                sampler,
-                counters,
-            )
+            tint * radiance(world, &hit.surface.spawn_ray(reflect(wo, facing)), depth_left - 1, w, sampler, counters)
         }
         MaterialModel::Glass { ior, tint } => {
             if !can_recurse {
                 return Rgb::ZERO;
             }
-            let (eta_i, eta_t) = if wo.dot(n) > 0.0 {
-                (1.0, ior)
-            } else {
-                (ior, 1.0)
-            };
+            let (eta_i, eta_t) = if wo.dot(n) > 0.0 { (1.0, ior) } else { (ior, 1.0) };
             let (fresnel, refracted, eta) = refract(wo, facing, eta_i, eta_t);
             let mut c = Rgb::ZERO;
             if weight * fresnel > MIN_WEIGHT {
@@ -125,14 +89,7 @@ pub fn radiance(
                 let w = weight * (1.0 - fresnel);
                 if w > MIN_WEIGHT {
                     // Radiance is compressed by η² crossing into the denser side
-                    let through = radiance(
-                        world,
-                        &hit.surface.spawn_ray(wt),
-                        depth_left - 1,
-                        w,
-                        sampler,
-                        counters,
-                    );
+                    let through = radiance(world, &hit.surface.spawn_ray(wt), depth_left - 1, w, sampler, counters);
                     c += (1.0 - fresnel) * eta * eta * through;
                 }
             }
@@ -171,11 +128,7 @@ fn local(
         let light_colour = sample.value * FRAC_1_PI;
         let mut c = kd * cos;
         if ks != Rgb::ZERO {
-            let highlight = if blinn {
-                n.dot((sample.wi + wo).normalize())
-            } else {
-                reflect(sample.wi, n).dot(wo)
-            };
+            let highlight = if blinn { n.dot((sample.wi + wo).normalize()) } else { reflect(sample.wi, n).dot(wo) };
             c += ks * highlight.max(0.0).powf(exponent);
         }
         total += light_colour * c;

@@ -105,11 +105,7 @@ impl World {
                 }
                 Shape::Plane { point, normal } => {
                     let normal = normal.normalize();
-                    world.planes.push(PlaneShape {
-                        normal,
-                        offset: normal.dot(*point),
-                        object: id,
-                    });
+                    world.planes.push(PlaneShape { normal, offset: normal.dot(*point), object: id });
                     ShapeRef::Plane(world.planes.len() as u32 - 1)
                 }
                 Shape::Triangle { a, b, c } => {
@@ -119,11 +115,7 @@ impl World {
                     ShapeRef::Triangle(world.triangles.len() as u32 - 1)
                 }
             };
-            world.objects.push(ObjectInfo {
-                shape,
-                material,
-                light: None,
-            });
+            world.objects.push(ObjectInfo { shape, material, light: None });
         }
         if lo.x <= hi.x {
             world.bounds_center = (lo + hi) * 0.5;
@@ -133,21 +125,13 @@ impl World {
         for light in scene.lights.iter().filter(|l| l.enabled) {
             let power = light.color * light.intensity;
             world.lights.push(match light.kind {
-                LightKind::Point { position } => LightSource::Point {
-                    position,
-                    intensity: power,
-                    attenuation: light.attenuation,
-                },
-                LightKind::Directional { direction } => LightSource::Directional {
-                    direction: direction.normalize(),
-                    irradiance: power,
-                },
-                LightKind::Spot {
-                    position,
-                    direction,
-                    cone_angle_degrees,
-                    falloff_exponent,
-                } => LightSource::Spot {
+                LightKind::Point { position } => {
+                    LightSource::Point { position, intensity: power, attenuation: light.attenuation }
+                }
+                LightKind::Directional { direction } => {
+                    LightSource::Directional { direction: direction.normalize(), irradiance: power }
+                }
+                LightKind::Spot { position, direction, cone_angle_degrees, falloff_exponent } => LightSource::Spot {
                     position,
                     direction: direction.normalize(),
                     cos_cone: cone_angle_degrees.to_radians().cos(),
@@ -169,10 +153,7 @@ impl World {
                 };
                 if sampled && radiance.max_element() > 0.0 {
                     world.objects[index].light = Some(world.lights.len() as u32);
-                    world.lights.push(LightSource::Area {
-                        object: index as u32,
-                        radiance,
-                    });
+                    world.lights.push(LightSource::Area { object: index as u32, radiance });
                 }
             }
         }
@@ -210,25 +191,15 @@ impl World {
         let (surface, object) = match best? {
             ShapeRef::Sphere(i) => {
                 let i = i as usize;
-                (
-                    sphere_hit(ray, s.center(i), s.radius[i], best_t, sphere_near),
-                    s.object[i],
-                )
+                (sphere_hit(ray, s.center(i), s.radius[i], best_t, sphere_near), s.object[i])
             }
             ShapeRef::Plane(i) => {
                 let plane = &self.planes[i as usize];
-                (
-                    plane_hit(ray, plane.normal, plane.offset, best_t),
-                    plane.object,
-                )
+                (plane_hit(ray, plane.normal, plane.offset, best_t), plane.object)
             }
             ShapeRef::Triangle(i) => (triangle_hit?, self.triangles[i as usize].1),
         };
-        Some(Hit {
-            surface,
-            object,
-            material: self.objects[object as usize].material,
-        })
+        Some(Hit { surface, object, material: self.objects[object as usize].material })
     }
 
     /// Whether anything lies on the ray in (0, t_max): shadow rays stop at the
@@ -237,14 +208,8 @@ impl World {
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         let s = &self.spheres;
         (0..s.radius.len()).any(|i| sphere_t(ray, s.center(i), s.radius[i], t_max).is_some())
-            || self
-                .planes
-                .iter()
-                .any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
-            || self
-                .triangles
-                .iter()
-                .any(|(t, _)| intersect_triangle(ray, t, t_max).is_some())
+            || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
+            || self.triangles.iter().any(|(t, _)| intersect_triangle(ray, t, t_max).is_some())
     }
 
     #[inline]

@@ -8,27 +8,13 @@ use super::{Invalid, Scene};
 #[derive(Debug, thiserror::Error)]
 pub enum SceneFileError {
     #[error("{path}: {source}")]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
     /// The text is not a well-formed scene (bad syntax, unknown or missing field).
     #[error("{path}:{line}:{column}: {message}")]
-    Syntax {
-        path: PathBuf,
-        line: usize,
-        column: usize,
-        message: String,
-    },
+    Syntax { path: PathBuf, line: usize, column: usize, message: String },
     /// Well-formed but a value is unusable; the position is the field's.
     #[error("{path}:{line}:{column}: {invalid}{more}", more = more_note(*.others))]
-    Invalid {
-        path: PathBuf,
-        line: usize,
-        column: usize,
-        invalid: Invalid,
-        others: usize,
-    },
+    Invalid { path: PathBuf, line: usize, column: usize, invalid: Invalid, others: usize },
     #[error("could not write the scene: {0}")]
     Serialize(String),
 }
@@ -42,24 +28,18 @@ fn more_note(others: usize) -> String {
 
 /// Read and validate a scene file.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneFileError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
+    let text = std::fs::read_to_string(path).map_err(|source| SceneFileError::Io { path: path.to_owned(), source })?;
     parse_scene(&text, path)
 }
 
 /// Parse and validate scene text; `path` is only used in messages.
 pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneFileError> {
-    let scene: Scene =
-        ron::Options::default()
-            .from_str(text)
-            .map_err(|e| SceneFileError::Syntax {
-                path: path.to_owned(),
-                line: e.span.start.line,
-                column: e.span.start.col,
-                message: e.code.to_string(),
-            })?;
+    let scene: Scene = ron::Options::default().from_str(text).map_err(|e| SceneFileError::Syntax {
+        path: path.to_owned(),
+        line: e.span.start.line,
+        column: e.span.start.col,
+        message: e.code.to_string(),
+    })?;
     let mut problems = scene.validate();
     if problems.is_empty() {
         return Ok(scene);
@@ -67,19 +47,11 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneFileError> {
     let others = problems.len() - 1;
     let invalid = problems.swap_remove(0);
     let (line, column) = locate(text, &invalid);
-    Err(SceneFileError::Invalid {
-        path: path.to_owned(),
-        line,
-        column,
-        invalid,
-        others,
-    })
+    Err(SceneFileError::Invalid { path: path.to_owned(), line, column, invalid, others })
 }
 
 pub fn to_ron(scene: &Scene) -> Result<String, SceneFileError> {
-    let config = ron::ser::PrettyConfig::new()
-        .depth_limit(4)
-        .struct_names(false);
+    let config = ron::ser::PrettyConfig::new().depth_limit(4).struct_names(false);
     ron::ser::to_string_pretty(scene, config).map_err(|e| SceneFileError::Serialize(e.to_string()))
 }
 
@@ -87,10 +59,7 @@ pub fn to_ron(scene: &Scene) -> Result<String, SceneFileError> {
 /// leaves half a scene behind.
 pub fn save_scene(scene: &Scene, path: &Path) -> Result<(), SceneFileError> {
     let text = to_ron(scene)?;
-    let io = |source| SceneFileError::Io {
-        path: path.to_owned(),
-        source,
-    };
+    let io = |source| SceneFileError::Io { path: path.to_owned(), source };
     let partial = path.with_extension("ron.partial");
     std::fs::write(&partial, text + "\n").map_err(io)?;
     std::fs::rename(&partial, path).map_err(io)
@@ -100,11 +69,7 @@ pub fn save_scene(scene: &Scene, path: &Path) -> Result<(), SceneFileError> {
 /// quoted name (the duplicate's second occurrence), then `key:`. RON gives no
 /// spans after deserialising, and names are unique, so this finds the field.
 fn locate(text: &str, invalid: &Invalid) -> (usize, usize) {
-    let section = if invalid.section == "scene" {
-        Some(0)
-    } else {
-        find_key(text, 0, invalid.section)
-    };
+    let section = if invalid.section == "scene" { Some(0) } else { find_key(text, 0, invalid.section) };
     let mut at = section.unwrap_or(0);
     if let Some(item) = &invalid.item {
         let quoted = format!("\"{item}\"");
@@ -130,8 +95,7 @@ fn find_key(text: &str, from: usize, key: &str) -> Option<usize> {
     let mut start = from;
     while let Some(found) = text[start..].find(key) {
         let at = start + found;
-        let before_ok = at == 0
-            || !text.as_bytes()[at - 1].is_ascii_alphanumeric() && text.as_bytes()[at - 1] != b'_';
+        let before_ok = at == 0 || !text.as_bytes()[at - 1].is_ascii_alphanumeric() && text.as_bytes()[at - 1] != b'_';
         let after = text[at + key.len()..].trim_start();
         if before_ok && after.starts_with(':') {
             return Some(at);

@@ -67,11 +67,7 @@ pub struct SceneSettings {
 
 impl Default for SceneSettings {
     fn default() -> Self {
-        Self {
-            width: 640,
-            height: 480,
-            exposure: 0.0,
-        }
+        Self { width: 640, height: 480, exposure: 0.0 }
     }
 }
 
@@ -217,11 +213,7 @@ pub struct Attenuation {
 
 impl Default for Attenuation {
     fn default() -> Self {
-        Self {
-            a: 1.0,
-            b: 0.0,
-            c: 0.0,
-        }
+        Self { a: 1.0, b: 0.0, c: 0.0 }
     }
 }
 
@@ -247,8 +239,6 @@ impl Scene {
     /// used to tie saved photon maps and references to the scene they belong to.
     pub fn content_key(&self) -> u64 {
         let text = to_ron(self).unwrap_or_default();
-        text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-            (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
-        })
+        text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
     }
 }

@@ -21,10 +21,7 @@ pub fn names() -> impl Iterator<Item = &'static str> {
 /// The preset called `name`, parsed and validated.
 pub fn preset(name: &str) -> Option<Result<Scene, SceneFileError>> {
     let (name, text) = PRESETS.iter().find(|(n, _)| *n == name)?;
-    Some(parse_scene(
-        text,
-        Path::new(&format!("assets/scenes/{name}.ron")),
-    ))
+    Some(parse_scene(text, Path::new(&format!("assets/scenes/{name}.ron"))))
 }
 
 /// The scene the studio opens on.
@@ -52,25 +49,15 @@ fn fallback_scene() -> Scene {
         background: Vec3::splat(0.1),
         ambient: Vec3::ZERO,
         settings: SceneSettings::default(),
-        materials: vec![Material {
-            name: "grey".into(),
-            model: MaterialModel::Lambert {
-                albedo: Vec3::splat(0.7),
-            },
-        }],
+        materials: vec![Material { name: "grey".into(), model: MaterialModel::Lambert { albedo: Vec3::splat(0.7) } }],
         objects: vec![Object {
             name: "ball".into(),
-            shape: Shape::Sphere {
-                center: Vec3::new(0.0, 0.5, 0.0),
-                radius: 0.5,
-            },
+            shape: Shape::Sphere { center: Vec3::new(0.0, 0.5, 0.0), radius: 0.5 },
             material: "grey".into(),
         }],
         lights: vec![Light {
             name: "light".into(),
-            kind: LightKind::Point {
-                position: Vec3::new(2.0, 3.0, 2.0),
-            },
+            kind: LightKind::Point { position: Vec3::new(2.0, 3.0, 2.0) },
             color: Vec3::ONE,
             intensity: 20.0,
             attenuation: Default::default(),
@@ -86,9 +73,7 @@ mod tests {
     #[test]
     fn every_preset_parses_and_validates() {
         for name in names() {
-            let scene = preset(name)
-                .expect("listed")
-                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let scene = preset(name).expect("listed").unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(!scene.objects.is_empty(), "{name}");
         }
         assert!(fallback_scene().validate().is_empty());

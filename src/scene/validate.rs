@@ -57,13 +57,7 @@ struct Checker<'a> {
 }
 
 impl<'a> Checker<'a> {
-    fn at(
-        &mut self,
-        section: &'static str,
-        index: Option<usize>,
-        item: Option<&'a str>,
-        middle: &str,
-    ) {
+    fn at(&mut self, section: &'static str, index: Option<usize>, item: Option<&'a str>, middle: &str) {
         self.section = section;
         self.item = item;
         self.prefix = match (index, item) {
@@ -124,14 +118,7 @@ impl<'a> Checker<'a> {
     fn reflectance(&mut self, key: &'static str, v: Vec3) {
         if self.vector(key, v) {
             if let Some(c) = v.to_array().into_iter().find(|c| !(0.0..=1.0).contains(c)) {
-                self.report(
-                    key,
-                    Problem::OutOfRange {
-                        min: 0.0,
-                        max: 1.0,
-                        found: c,
-                    },
-                );
+                self.report(key, Problem::OutOfRange { min: 0.0, max: 1.0, found: c });
             }
         }
     }
@@ -146,17 +133,11 @@ impl<'a> Checker<'a> {
 }
 
 pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
-    let mut check = Checker {
-        found: Vec::new(),
-        section: "camera",
-        item: None,
-        prefix: String::new(),
-    };
+    let mut check = Checker { found: Vec::new(), section: "camera", item: None, prefix: String::new() };
 
     let camera = &scene.camera;
     check.at("camera", None, None, "");
-    let placed =
-        check.vector("position", camera.position) & check.vector("look_at", camera.look_at);
+    let placed = check.vector("position", camera.position) & check.vector("look_at", camera.look_at);
     if check.vector("up", camera.up) {
         if camera.up.length_squared() == 0.0 {
             check.report("up", Problem::ZeroLength);
@@ -172,33 +153,16 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
     if check.finite("fov_y_degrees", camera.fov_y_degrees)
         && !(camera.fov_y_degrees > 0.0 && camera.fov_y_degrees < 180.0)
     {
-        check.report(
-            "fov_y_degrees",
-            Problem::OutOfRange {
-                min: 0.0,
-                max: 180.0,
-                found: camera.fov_y_degrees,
-            },
-        );
+        check.report("fov_y_degrees", Problem::OutOfRange { min: 0.0, max: 180.0, found: camera.fov_y_degrees });
     }
     check.non_negative("near_clip", camera.near_clip);
     check.non_negative("aperture_radius", camera.aperture_radius);
     check.non_negative("focus_distance", camera.focus_distance);
 
     check.at("settings", None, None, "");
-    for (key, v) in [
-        ("width", scene.settings.width),
-        ("height", scene.settings.height),
-    ] {
+    for (key, v) in [("width", scene.settings.width), ("height", scene.settings.height)] {
         if !(1..=16384).contains(&v) {
-            check.report(
-                key,
-                Problem::OutOfRange {
-                    min: 1.0,
-                    max: 16384.0,
-                    found: v as f32,
-                },
-            );
+            check.report(key, Problem::OutOfRange { min: 1.0, max: 16384.0, found: v as f32 });
         }
     }
     check.finite("exposure", scene.settings.exposure);
@@ -213,18 +177,7 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
         check.at("materials", Some(i), Some(&material.name), ".model");
         match &material.model {
             MaterialModel::Lambert { albedo } => check.reflectance("albedo", *albedo),
-            MaterialModel::Phong {
-                ka,
-                kd,
-                ks,
-                shininess,
-            }
-            | MaterialModel::BlinnPhong {
-                ka,
-                kd,
-                ks,
-                shininess,
-            } => {
+            MaterialModel::Phong { ka, kd, ks, shininess } | MaterialModel::BlinnPhong { ka, kd, ks, shininess } => {
                 check.reflectance("ka", *ka);
                 check.reflectance("kd", *kd);
                 check.reflectance("ks", *ks);
@@ -244,10 +197,7 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
         check.at("objects", Some(i), Some(&object.name), "");
         check.name(&mut names, &object.name);
         if scene.material_index(&object.material).is_none() {
-            check.report(
-                "material",
-                Problem::UnknownMaterial(object.material.clone()),
-            );
+            check.report("material", Problem::UnknownMaterial(object.material.clone()));
         }
         check.at("objects", Some(i), Some(&object.name), ".shape");
         match &object.shape {
@@ -277,9 +227,7 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
         let falloff = &light.attenuation;
         let directional = matches!(light.kind, LightKind::Directional { .. });
         check.at("lights", Some(i), Some(&light.name), ".attenuation");
-        let finite = check.finite("a", falloff.a)
-            & check.finite("b", falloff.b)
-            & check.finite("c", falloff.c);
+        let finite = check.finite("a", falloff.a) & check.finite("b", falloff.b) & check.finite("c", falloff.c);
         if finite && !directional {
             if falloff.a < 0.0 || falloff.b < 0.0 || falloff.c < 0.0 {
                 let key = if falloff.a < 0.0 {
@@ -289,10 +237,7 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
                 } else {
                     "c"
                 };
-                check.report(
-                    key,
-                    Problem::Negative(falloff.a.min(falloff.b).min(falloff.c)),
-                );
+                check.report(key, Problem::Negative(falloff.a.min(falloff.b).min(falloff.c)));
             } else if falloff.a == 0.0 && falloff.b == 0.0 && falloff.c == 0.0 {
                 check.report("a", Problem::ZeroAttenuation);
             }
@@ -303,21 +248,13 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
                 check.vector("position", *position);
             }
             LightKind::Directional { direction } => check.direction("direction", *direction),
-            LightKind::Spot {
-                position,
-                direction,
-                cone_angle_degrees,
-                falloff_exponent,
-            } => {
+            LightKind::Spot { position, direction, cone_angle_degrees, falloff_exponent } => {
                 check.vector("position", *position);
                 check.direction("direction", *direction);
                 if check.finite("cone_angle_degrees", *cone_angle_degrees)
                     && !(*cone_angle_degrees > 0.0 && *cone_angle_degrees <= 90.0)
                 {
-                    check.report(
-                        "cone_angle_degrees",
-                        Problem::ConeAngle(*cone_angle_degrees),
-                    );
+                    check.report("cone_angle_degrees", Problem::ConeAngle(*cone_angle_degrees));
                 }
                 check.non_negative("falloff_exponent", *falloff_exponent);
             }
