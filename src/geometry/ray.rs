@@ -27,22 +27,17 @@ pub const fn gamma(n: u32) -> f32 {
     e / (1.0 - e)
 }
 
-/// Offset that covers the rounding of a point of this magnitude
-/// (Wächter & Binder, Ray Tracing Gems ch. 6: 256 ulps, or a fixed floor near
-/// the origin where ulps vanish).
+/// Offset that covers the rounding of a point of this magnitude: 256 ulps of
+/// its largest coordinate (Wächter & Binder, Ray Tracing Gems ch. 6). Their
+/// fixed floor near the origin is dropped: each shape reports its own error
+/// bound, so the offset can stay relative and tiny scenes keep working.
 #[inline]
 pub(crate) fn spawn_offset_scale(p: Vec3) -> f32 {
-    const ORIGIN: f32 = 1.0 / 32.0;
-    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
-    const INT_SCALE: f32 = 256.0;
-    let m = p.abs().max_element();
-    if m < ORIGIN {
-        FLOAT_SCALE
-    } else {
-        // ulp(m) · 256, computed from the exponent so it is exact and cheap.
-        let ulp = f32::from_bits((m.to_bits() & 0x7f80_0000).saturating_sub(23 << 23));
-        ulp * INT_SCALE
-    }
+    const ULPS: f32 = 256.0;
+    let m = p.abs().max_element().max(f32::MIN_POSITIVE);
+    // ulp(m) from the exponent: exact and cheap
+    let ulp = f32::from_bits((m.to_bits() & 0x7f80_0000).saturating_sub(23 << 23)).max(f32::from_bits(1));
+    ulp * ULPS
 }
 
 /// Move a point computed on a surface off it, to the side `direction` points
@@ -78,7 +73,8 @@ mod tests {
         let small = spawn_offset_scale(Vec3::splat(1.0));
         let large = spawn_offset_scale(Vec3::splat(1.0e6));
         assert!(large > small * 1.0e5);
-        assert_eq!(spawn_offset_scale(Vec3::ZERO), 1.0 / 65536.0);
+        assert!(spawn_offset_scale(Vec3::ZERO) > 0.0);
+        assert!(spawn_offset_scale(Vec3::splat(1e-8)) < 1e-12);
     }
 
     #[test]

@@ -1,0 +1,161 @@
+//! Renders checked against radiance known in closed form.
+
+mod common;
+
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+use common::*;
+use gi_studio::geometry::Ray;
+use gi_studio::render::rng::Sampler;
+use gi_studio::render::world::World;
+use gi_studio::render::{path, render_blocking, whitted, Algorithm, Counters, RenderJob, RenderSettings};
+use gi_studio::scene::{LightKind, MaterialModel, Shape};
+use glam::Vec3;
+
+fn trace(algorithm: Algorithm, world: &World, ray: &Ray, samples: u32) -> Vec3 {
+    let mut counters = Counters::default();
+    let mut sum = Vec3::ZERO;
+    for s in 0..samples {
+        let mut sampler = Sampler::new(1, s as u64, 7);
+        sum += match algorithm {
+            Algorithm::Whitted => whitted::radiance(world, ray, 5, 1.0, &mut sampler, &mut counters),
+            _ => path::radiance(world, ray, 32, &mut sampler, &mut counters),
+        };
+    }
+    sum / samples as f32
+}
+
+fn render(scene: gi_studio::scene::Scene, algorithm: Algorithm, spp: u32) -> gi_studio::render::LinearImage {
+    let settings = RenderSettings {
+        width: scene.settings.width,
+        height: scene.settings.height,
+        samples_per_pixel: Some(spp),
+        ..RenderSettings::for_algorithm(algorithm)
+    };
+    render_blocking(&RenderJob { scene: Arc::new(scene), settings }).expect("renders").0
+}
+
+#[test]
+fn lambert_plane_under_a_directional_light() {
+    let direction = Vec3::new(0.3, -1.0, -0.5).normalize();
+    let scene = floor_scene(0.6, vec![light("sun", LightKind::Directional { direction }, 2.0)]);
+    let world = World::new(&scene);
+    let expected = 0.6 / PI * 2.0 * (-direction).dot(Vec3::Y);
+    for algorithm in [Algorithm::Path, Algorithm::Whitted] {
+        for target in [Vec3::ZERO, Vec3::new(3.0, 0.0, -7.0), Vec3::new(-40.0, 0.0, 2.0)] {
+            let origin = Vec3::new(0.5, 2.0, 4.0);
+            let got = trace(algorithm, &world, &Ray::new(origin, (target - origin).normalize()), 64);
+            assert!((got.x - expected).abs() < 0.01 * expected, "{algorithm}: {got} vs {expected}");
+        }
+    }
+}
+
+#[test]
+fn lambert_plane_under_a_point_light() {
+    let position = Vec3::new(0.4, 1.5, -0.2);
+    let scene = floor_scene(0.8, vec![light("bulb", LightKind::Point { position }, 5.0)]);
+    let world = World::new(&scene);
+    for target in [Vec3::ZERO, Vec3::new(1.0, 0.0, -1.0), Vec3::new(-3.0, 0.0, 0.5)] {
+        let to_light = position - target;
+        let d = to_light.length();
+        let expected = 0.8 / PI * 5.0 * (to_light.y / d) / (d * d);
+        let origin = Vec3::new(0.0, 3.0, 3.0);
+        for algorithm in [Algorithm::Path, Algorithm::Whitted] {
+            let got = trace(algorithm, &world, &Ray::new(origin, (target - origin).normalize()), 64);
+            assert!((got.y - expected).abs() < 0.01 * expected, "{algorithm} at {target}: {got} vs {expected}");
+        }
+    }
+}
+
+#[test]
+fn white_furnace_stays_one_and_half_albedo_gives_half() {
+    for (albedo, expected) in [(1.0f32, 1.0f64), (0.5, 0.5)] {
+        let mut scene = scene(
+            camera(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO),
+            vec![material("grey", lambert(albedo))],
+            vec![object("ball", Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, "grey")],
+            vec![],
+        );
+        // Uniform environment of radiance 1, the sphere fills the middle of the frame
+        scene.background = Vec3::ONE;
+        scene.camera.fov_y_degrees = 20.0;
+        let image = render(scene, Algorithm::Path, 16);
+        let centre: Vec<[f32; 3]> = (8..16).flat_map(|y| (12..20).map(move |x| (x, y))).map(|(x, y)| image.get(x, y)).collect();
+        let mean = mean_luminance(&centre);
+        assert!((mean - expected).abs() < 0.01 * expected, "albedo {albedo}: {mean}");
+    }
+}
+
+/// Inside a closed sphere of radius 1 and albedo ρ, a point light of
+/// intensity π at the centre gives direct radiance ρ and, with every bounce,
+/// ρ/(1 − ρ)·(E/π) = 1 for ρ = ½. Whitted stops at the direct term.
+#[test]
+fn closed_sphere_furnace_converges_to_one() {
+    let mut scene = scene(
+        camera(Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.0, 0.0, -1.0)),
+        vec![material("inside", lambert(0.5))],
+        vec![object("shell", Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, "inside")],
+        vec![light("centre", LightKind::Point { position: Vec3::ZERO }, PI)],
+    );
+    scene.camera.fov_y_degrees = 60.0;
+    let full = mean_luminance(&render(scene.clone(), Algorithm::Path, 256).pixels);
+    assert!((full - 1.0).abs() < 0.01, "path: {full}");
+    let direct = mean_luminance(&render(scene, Algorithm::Whitted, 1).pixels);
+    assert!((direct - 0.5).abs() < 1e-3, "whitted: {direct}");
+}
+
+/// The thesis' Phong formula by hand: ka·La + (I/d²/π)·(kd (l·n) + ks (r·v)^α).
+#[test]
+fn whitted_phong_sphere_matches_the_hand_computation() {
+    let (ka, kd, ks, alpha) = (Vec3::new(0.2, 0.1, 0.0), Vec3::new(0.5, 0.3, 0.1), Vec3::new(0.3, 0.3, 0.3), 12.0);
+    let light_position = Vec3::new(2.0, 3.0, 4.0);
+    let mut scene = scene(
+        camera(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO),
+        vec![material("plastic", MaterialModel::Phong { ka, kd, ks, shininess: alpha })],
+        vec![object("ball", Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, "plastic")],
+        vec![light("bulb", LightKind::Point { position: light_position }, 20.0)],
+    );
+    scene.ambient = Vec3::splat(0.1);
+    let world = World::new(&scene);
+    let camera = gi_studio::render::camera::CameraModel::new(&scene.camera, 64, 48);
+    for (px, py) in [(32.0, 24.0), (36.5, 20.5), (28.0, 27.0), (34.0, 22.0)] {
+        let ray = camera.pixel_ray(px, py);
+        // Oracle in f64: hit point, normal, light and view vectors
+        let (o, d) = (ray.origin.as_dvec3(), ray.direction.as_dvec3());
+        let b = o.dot(d);
+        let t = -b - (b * b - (o.length_squared() - 1.0)).sqrt();
+        let p = o + d * t;
+        let n = p.normalize();
+        let to_light = light_position.as_dvec3() - p;
+        let (dist, l) = (to_light.length(), to_light.normalize());
+        let v = -d;
+        let r = 2.0 * l.dot(n) * n - l;
+        let light = 20.0 / (dist * dist) / std::f64::consts::PI;
+        let expected = (ka * 0.1).as_dvec3() + light * (kd.as_dvec3() * l.dot(n).max(0.0) + ks.as_dvec3() * r.dot(v).max(0.0).powf(12.0));
+        let got = trace(Algorithm::Whitted, &world, &ray, 1).as_dvec3();
+        assert!((got - expected).abs().max_element() < 1e-4, "pixel ({px}, {py}): {got} vs {expected}");
+        assert!(expected.x > 0.05, "the chosen pixel must be lit");
+    }
+}
+
+#[test]
+fn spot_cone_edge_falls_where_cos_theta_says() {
+    let cone = 20.0f32;
+    let height = 2.0f32;
+    let spot = LightKind::Spot {
+        position: Vec3::new(0.0, height, 0.0),
+        direction: -Vec3::Y,
+        cone_angle_degrees: cone,
+        falloff_exponent: 0.0,
+    };
+    let scene = floor_scene(0.5, vec![light("spot", spot, 10.0)]);
+    let world = World::new(&scene);
+    let edge = height * cone.to_radians().tan();
+    let origin = Vec3::new(0.0, 5.0, 0.01);
+    for (radius, lit) in [(edge * 0.99, true), (edge * 1.01, false), (0.0, true), (edge * 2.0, false)] {
+        let target = Vec3::new(radius, 0.0, 0.0);
+        let got = trace(Algorithm::Whitted, &world, &Ray::new(origin, (target - origin).normalize()), 1);
+        assert_eq!(got.x > 0.0, lit, "radius {radius} (edge {edge}): {got}");
+    }
+}

@@ -1,0 +1,51 @@
+//! Small scenes built in code for closed-form tests.
+#![allow(dead_code)]
+
+use gi_studio::scene::*;
+use glam::Vec3;
+
+pub fn camera(position: Vec3, look_at: Vec3) -> Camera {
+    Camera { position, look_at, up: Vec3::Y, fov_y_degrees: 40.0, near_clip: 0.0, aperture_radius: 0.0, focus_distance: 0.0 }
+}
+
+pub fn material(name: &str, model: MaterialModel) -> Material {
+    Material { name: name.into(), model }
+}
+
+pub fn object(name: &str, shape: Shape, material: &str) -> Object {
+    Object { name: name.into(), shape, material: material.into() }
+}
+
+pub fn light(name: &str, kind: LightKind, intensity: f32) -> Light {
+    Light { name: name.into(), kind, color: Vec3::ONE, intensity, attenuation: Attenuation::default(), enabled: true }
+}
+
+pub fn lambert(albedo: f32) -> MaterialModel {
+    MaterialModel::Lambert { albedo: Vec3::splat(albedo) }
+}
+
+pub fn scene(camera: Camera, materials: Vec<Material>, objects: Vec<Object>, lights: Vec<Light>) -> Scene {
+    Scene {
+        camera,
+        background: Vec3::ZERO,
+        ambient: Vec3::ZERO,
+        settings: SceneSettings { width: 32, height: 24, exposure: 0.0 },
+        materials,
+        objects,
+        lights,
+    }
+}
+
+/// A floor plane of albedo `albedo` seen from above.
+pub fn floor_scene(albedo: f32, lights: Vec<Light>) -> Scene {
+    scene(
+        camera(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO),
+        vec![material("floor", lambert(albedo))],
+        vec![object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor")],
+        lights,
+    )
+}
+
+pub fn mean_luminance(pixels: &[[f32; 3]]) -> f64 {
+    pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / pixels.len() as f64
+}
