@@ -14,9 +14,8 @@ use glam::Vec3;
 
 fn ray_sphere(c: &mut Criterion) {
     let mut s = Sampler::new(0, 0, 1);
-    let rays: Vec<Ray> = (0..4096)
-        .map(|_| Ray::new(uniform_sphere(s.next_2d()) * 10.0, uniform_sphere(s.next_2d())))
-        .collect();
+    let rays: Vec<Ray> =
+        (0..4096).map(|_| Ray::new(uniform_sphere(s.next_2d()) * 10.0, uniform_sphere(s.next_2d()))).collect();
     let mut group = c.benchmark_group("geometry");
     group.throughput(Throughput::Elements(rays.len() as u64));
     group.bench_function("ray_sphere_intersections", |b| {

@@ -5,5 +5,6 @@
 
 pub mod cli;
 pub mod geometry;
+pub mod photon;
 pub mod render;
 pub mod scene;

@@ -18,14 +18,29 @@ fn render_writes_png_and_exr_and_prints_a_summary() {
     for (algo, file) in [("path", "a.png"), ("whitted", "b.exr")] {
         let out = dir.join(file);
         let output = gi_studio()
-            .args(["render", "assets/scenes/cornell.ron", "--algo", algo, "--spp", "2", "--width", "40", "--height", "30", "-o"])
+            .args([
+                "render",
+                "assets/scenes/cornell.ron",
+                "--algo",
+                algo,
+                "--spp",
+                "2",
+                "--width",
+                "40",
+                "--height",
+                "30",
+                "-o",
+            ])
             .arg(&out)
             .output()
             .unwrap();
         assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
         let summary = String::from_utf8_lossy(&output.stdout);
         assert!(summary.contains("40×30") && summary.contains(algo) && summary.contains("2 spp"), "{summary}");
-        assert!(summary.contains("samples/s") && summary.contains("rays/s") && summary.contains("0 non-finite"), "{summary}");
+        assert!(
+            summary.contains("samples/s") && summary.contains("rays/s") && summary.contains("0 non-finite"),
+            "{summary}"
+        );
         let image = gi_studio::render::LinearImage::load(&out).unwrap();
         assert_eq!((image.width, image.height), (40, 30));
     }

@@ -81,7 +81,8 @@ fn white_furnace_stays_one_and_half_albedo_gives_half() {
         scene.background = Vec3::ONE;
         scene.camera.fov_y_degrees = 20.0;
         let image = render(scene, Algorithm::Path, 16);
-        let centre: Vec<[f32; 3]> = (8..16).flat_map(|y| (12..20).map(move |x| (x, y))).map(|(x, y)| image.get(x, y)).collect();
+        let centre: Vec<[f32; 3]> =
+            (8..16).flat_map(|y| (12..20).map(move |x| (x, y))).map(|(x, y)| image.get(x, y)).collect();
         let mean = mean_luminance(&centre);
         assert!((mean - expected).abs() < 0.01 * expected, "albedo {albedo}: {mean}");
     }
@@ -132,7 +133,8 @@ fn whitted_phong_sphere_matches_the_hand_computation() {
         let v = -d;
         let r = 2.0 * l.dot(n) * n - l;
         let light = 20.0 / (dist * dist) / std::f64::consts::PI;
-        let expected = (ka * 0.1).as_dvec3() + light * (kd.as_dvec3() * l.dot(n).max(0.0) + ks.as_dvec3() * r.dot(v).max(0.0).powf(12.0));
+        let expected = (ka * 0.1).as_dvec3()
+            + light * (kd.as_dvec3() * l.dot(n).max(0.0) + ks.as_dvec3() * r.dot(v).max(0.0).powf(12.0));
         let got = trace(Algorithm::Whitted, &world, &ray, 1).as_dvec3();
         assert!((got - expected).abs().max_element() < 1e-4, "pixel ({px}, {py}): {got} vs {expected}");
         assert!(expected.x > 0.05, "the chosen pixel must be lit");

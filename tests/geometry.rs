@@ -40,13 +40,16 @@ fn smallpt_walls_agree_with_the_oracle_for_camera_rays() {
             let ray = camera.pixel_ray(x as f32 + 0.5, y as f32 + 0.5);
             for (center, radius) in &walls {
                 let got = intersect_sphere(&ray, *center, *radius, f32::INFINITY).map(|h| h.t as f64);
-                let want = sphere_oracle(ray.origin.as_dvec3(), ray.direction.as_dvec3(), center.as_dvec3(), *radius as f64);
+                let want =
+                    sphere_oracle(ray.origin.as_dvec3(), ray.direction.as_dvec3(), center.as_dvec3(), *radius as f64);
                 // f32 cannot know c = |f|² − r² better than ε|f|² when |f| ≈ r = 1e5,
                 // and t = c/q inherits that over |q| ≥ |f·d|: the bound to hold.
                 let f = (ray.origin - *center).as_dvec3();
                 let tolerance = 2.0 * f32::EPSILON as f64 * f.length_squared() / f.dot(ray.direction.as_dvec3()).abs();
                 match (got, want) {
-                    (Some(g), Some(w)) => assert!((g - w).abs() <= tolerance, "pixel ({x},{y}): {g} vs {w} (tolerance {tolerance})"),
+                    (Some(g), Some(w)) => {
+                        assert!((g - w).abs() <= tolerance, "pixel ({x},{y}): {g} vs {w} (tolerance {tolerance})")
+                    }
                     (None, None) => {}
                     other => panic!("pixel ({x},{y}): {other:?}"),
                 }
@@ -86,7 +89,10 @@ fn respawned_rays_never_hit_their_own_surface_at_any_scale() {
                 if d.dot(hit.normal) < 0.0 {
                     d = -d;
                 }
-                assert!(intersect_sphere(&hit.spawn_ray(d), center, radius, f32::INFINITY).is_none(), "scale {scale}: self-hit leaving");
+                assert!(
+                    intersect_sphere(&hit.spawn_ray(d), center, radius, f32::INFINITY).is_none(),
+                    "scale {scale}: self-hit leaving"
+                );
                 let outside = hit.point + d * radius * (0.01 + 3.0 * s.next_f32());
                 let (shadow, t_max) = hit.spawn_ray_to(outside, 0.0);
                 assert!(intersect_sphere(&shadow, center, radius, t_max).is_none(), "scale {scale}: shadow self-hit");
@@ -106,7 +112,10 @@ fn respawned_rays_never_hit_their_own_surface_at_any_scale() {
                 for side in [1.0, -1.0] {
                     let d = (hit.normal * side + random_direction(&mut s) * 0.7).normalize();
                     if d.dot(hit.normal) * side > 0.0 {
-                        assert!(intersect_plane(&hit.spawn_ray(d), normal, offset, f32::INFINITY).is_none(), "scale {scale}: plane self-hit");
+                        assert!(
+                            intersect_plane(&hit.spawn_ray(d), normal, offset, f32::INFINITY).is_none(),
+                            "scale {scale}: plane self-hit"
+                        );
                     }
                 }
             }
@@ -118,7 +127,10 @@ fn respawned_rays_never_hit_their_own_surface_at_any_scale() {
                 for side in [1.0, -1.0] {
                     let d = (hit.normal * side + random_direction(&mut s) * 0.7).normalize();
                     if d.dot(hit.normal) * side > 0.0 {
-                        assert!(intersect_triangle(&hit.spawn_ray(d), &triangle, f32::INFINITY).is_none(), "scale {scale}: triangle self-hit");
+                        assert!(
+                            intersect_triangle(&hit.spawn_ray(d), &triangle, f32::INFINITY).is_none(),
+                            "scale {scale}: triangle self-hit"
+                        );
                     }
                 }
             }

@@ -48,32 +48,51 @@ fn every_preset_round_trips() {
 #[test]
 fn negative_radius() {
     let e = broken(CORNELL, "radius: 0.35), material: \"mirror\"", "radius: -0.35), material: \"mirror\"");
-    assert_invalid(e, "objects[5] \"mirror ball\".shape.radius", line_of(CORNELL, "\"mirror ball\""), |p| matches!(p, Problem::NotPositive(r) if *r == -0.35));
+    assert_invalid(
+        e,
+        "objects[5] \"mirror ball\".shape.radius",
+        line_of(CORNELL, "\"mirror ball\""),
+        |p| matches!(p, Problem::NotPositive(r) if *r == -0.35),
+    );
 }
 
 #[test]
 fn zero_radius() {
     let e = broken(CORNELL, "radius: 0.35), material: \"glass\"", "radius: 0.0), material: \"glass\"");
-    assert_invalid(e, "objects[6] \"glass ball\".shape.radius", line_of(CORNELL, "\"glass ball\", shape"), |p| matches!(p, Problem::NotPositive(_)));
+    assert_invalid(e, "objects[6] \"glass ball\".shape.radius", line_of(CORNELL, "\"glass ball\", shape"), |p| {
+        matches!(p, Problem::NotPositive(_))
+    });
 }
 
 #[test]
 fn not_a_number() {
     let e = broken(CORNELL, "fov_y_degrees: 40.0", "fov_y_degrees: NaN");
-    assert_invalid(e, "camera.fov_y_degrees", line_of(CORNELL, "fov_y_degrees"), |p| matches!(p, Problem::NotFinite(v) if v.is_nan()));
+    assert_invalid(
+        e,
+        "camera.fov_y_degrees",
+        line_of(CORNELL, "fov_y_degrees"),
+        |p| matches!(p, Problem::NotFinite(v) if v.is_nan()),
+    );
 }
 
 #[test]
 fn infinity() {
     let e = broken(CORNELL, "radiance: (15.0, 15.0, 15.0)", "radiance: (15.0, inf, 15.0)");
-    assert_invalid(e, "materials[5] \"panel\".model.radiance", line_of(CORNELL, "radiance"), |p| matches!(p, Problem::NotFinite(v) if v.is_infinite()));
+    assert_invalid(
+        e,
+        "materials[5] \"panel\".model.radiance",
+        line_of(CORNELL, "radiance"),
+        |p| matches!(p, Problem::NotFinite(v) if v.is_infinite()),
+    );
 }
 
 #[test]
 fn cone_angle_zero_and_above_ninety() {
     for angle in ["0.0", "95.0"] {
         let e = broken(LIGHTS, "cone_angle_degrees: 25.0", &format!("cone_angle_degrees: {angle}"));
-        assert_invalid(e, "lights[1] \"spot\".kind.cone_angle_degrees", line_of(LIGHTS, "cone_angle_degrees"), |p| matches!(p, Problem::ConeAngle(_)));
+        assert_invalid(e, "lights[1] \"spot\".kind.cone_angle_degrees", line_of(LIGHTS, "cone_angle_degrees"), |p| {
+            matches!(p, Problem::ConeAngle(_))
+        });
     }
 }
 
@@ -99,28 +118,36 @@ fn up_parallel_to_view() {
 fn attenuation_all_zero() {
     let text = LIGHTS.replacen("intensity: 12.0)", "intensity: 12.0, attenuation: (a: 0.0, b: 0.0, c: 0.0))", 1);
     let e = broken(&text, "attenuation: (a: 0.0", "attenuation: (a: 0.0");
-    assert_invalid(e, "lights[0] \"point\".attenuation.a", line_of(&text, "attenuation"), |p| *p == Problem::ZeroAttenuation);
+    assert_invalid(e, "lights[0] \"point\".attenuation.a", line_of(&text, "attenuation"), |p| {
+        *p == Problem::ZeroAttenuation
+    });
 }
 
 #[test]
 fn index_of_refraction_not_positive() {
     for ior in ["0.0", "-1.5"] {
         let e = broken(CORNELL, "ior: 1.5", &format!("ior: {ior}"));
-        assert_invalid(e, "materials[4] \"glass\".model.ior", line_of(CORNELL, "ior:"), |p| matches!(p, Problem::NotPositive(_)));
+        assert_invalid(e, "materials[4] \"glass\".model.ior", line_of(CORNELL, "ior:"), |p| {
+            matches!(p, Problem::NotPositive(_))
+        });
     }
 }
 
 #[test]
 fn unknown_material() {
     let e = broken(CORNELL, "material: \"green\")", "material: \"teal\")");
-    assert_invalid(e, "objects[4] \"right wall\".material", line_of(CORNELL, "\"right wall\""), |p| *p == Problem::UnknownMaterial("teal".into()));
+    assert_invalid(e, "objects[4] \"right wall\".material", line_of(CORNELL, "\"right wall\""), |p| {
+        *p == Problem::UnknownMaterial("teal".into())
+    });
 }
 
 #[test]
 fn duplicate_names() {
     let e = broken(CORNELL, "(name: \"glass ball\"", "(name: \"mirror ball\"");
     let text = CORNELL.replacen("(name: \"glass ball\"", "(name: \"mirror ball\"", 1);
-    assert_invalid(e, "objects[6] \"mirror ball\".name", line_of(&text, "\"right wall\"") + 2, |p| *p == Problem::DuplicateName("mirror ball".into()));
+    assert_invalid(e, "objects[6] \"mirror ball\".name", line_of(&text, "\"right wall\"") + 2, |p| {
+        *p == Problem::DuplicateName("mirror ball".into())
+    });
 }
 
 #[test]

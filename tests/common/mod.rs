@@ -5,7 +5,15 @@ use gi_studio::scene::*;
 use glam::Vec3;
 
 pub fn camera(position: Vec3, look_at: Vec3) -> Camera {
-    Camera { position, look_at, up: Vec3::Y, fov_y_degrees: 40.0, near_clip: 0.0, aperture_radius: 0.0, focus_distance: 0.0 }
+    Camera {
+        position,
+        look_at,
+        up: Vec3::Y,
+        fov_y_degrees: 40.0,
+        near_clip: 0.0,
+        aperture_radius: 0.0,
+        focus_distance: 0.0,
+    }
 }
 
 pub fn material(name: &str, model: MaterialModel) -> Material {

@@ -1,0 +1,249 @@
+//! Where photons come from: every enabled light emits in proportion to its
+//! power. Point lights uniformly over the sphere, spot lights within their
+//! cone weighted by the falloff, directional lights from a disc covering the
+//! scene, area lights from their surface with cosine-weighted directions.
+
+use std::f32::consts::PI;
+
+use glam::{Vec2, Vec3};
+
+use crate::geometry::{offset_ray_origin, Frame, Ray};
+use crate::render::light::{spot_factor, LightSource};
+use crate::render::rng::Sampler;
+use crate::render::sampling::{cosine_hemisphere, uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_triangle};
+use crate::render::world::{ShapeRef, World};
+use crate::scene::Rgb;
+
+#[inline]
+fn luminance(c: Rgb) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// Total emitted power (W) of a light.
+pub fn light_power(world: &World, light: &LightSource) -> Rgb {
+    match *light {
+        LightSource::Point { intensity, .. } => intensity * (4.0 * PI),
+        LightSource::Spot { intensity, cos_cone, exponent, .. } => {
+            // ∫ over the cone of cos^σ θ dω = 2π (1 − cos^{σ+1} θc)/(σ + 1)
+            intensity * (2.0 * PI * (1.0 - cos_cone.powf(exponent + 1.0)) / (exponent + 1.0))
+        }
+        LightSource::Directional { irradiance, .. } => irradiance * (PI * world.bounds_radius * world.bounds_radius),
+        LightSource::Area { object, radiance } => radiance * (PI * emitter_area(world, object)),
+    }
+}
+
+fn emitter_area(world: &World, object: u32) -> f32 {
+    match world.objects[object as usize].shape {
+        ShapeRef::Sphere(i) => 4.0 * PI * world.spheres.radius[i as usize].powi(2),
+        ShapeRef::Triangle(t) => world.triangles[t as usize].0.area(),
+        ShapeRef::Plane(_) => 0.0,
+    }
+}
+
+/// Picks lights in proportion to their power (luminance), so every photon
+/// carries about the same power.
+#[derive(Clone, Debug)]
+pub struct LightPicker {
+    cdf: Vec<f32>,
+    total: f32,
+}
+
+impl LightPicker {
+    pub fn new(world: &World) -> Self {
+        let mut cdf = Vec::with_capacity(world.lights.len());
+        let mut total = 0.0;
+        for light in &world.lights {
+            total += luminance(light_power(world, light)).max(0.0);
+            cdf.push(total);
+        }
+        Self { cdf, total }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        !(self.total > 0.0)
+    }
+
+    /// (light index, probability of picking it).
+    #[inline]
+    pub fn pick(&self, u: f32) -> Option<(usize, f32)> {
+        if self.is_empty() {
+            return None;
+        }
+        let target = u * self.total;
+        let index = self.cdf.partition_point(|c| *c <= target).min(self.cdf.len() - 1);
+        let previous = if index == 0 { 0.0 } else { self.cdf[index - 1] };
+        let probability = (self.cdf[index] - previous) / self.total;
+        (probability > 0.0).then_some((index, probability))
+    }
+}
+
+/// A photon leaving a light: its ray and power (W, before dividing by the
+/// number of photons emitted).
+#[derive(Clone, Copy, Debug)]
+pub struct EmittedPhoton {
+    pub ray: Ray,
+    pub power: Rgb,
+}
+
+/// Emit one photon from a power-chosen light.
+pub fn emit(world: &World, picker: &LightPicker, sampler: &mut Sampler) -> Option<EmittedPhoton> {
+    let (index, pick) = picker.pick(sampler.next_f32())?;
+    let light = &world.lights[index];
+    let (u1, u2) = (sampler.next_2d(), sampler.next_2d());
+    let (ray, power) = match *light {
+        LightSource::Point { position, intensity, .. } => {
+            (Ray::new(position, uniform_sphere(u1)), intensity * (4.0 * PI))
+        }
+        LightSource::Spot { position, direction, cos_cone, exponent, intensity, .. } => {
+            let one_minus_cos = 1.0 - cos_cone;
+            let d = Frame::from_z(direction).to_world(uniform_cone(u1, one_minus_cos));
+            let falloff = spot_factor(direction, d, cos_cone, exponent);
+            (Ray::new(position, d), intensity * (falloff / uniform_cone_pdf(one_minus_cos)))
+        }
+        LightSource::Directional { direction, irradiance } => {
+            let radius = world.bounds_radius;
+            let frame = Frame::from_z(direction);
+            let disc = crate::render::sampling::concentric_disk(u1) * radius;
+            let origin = world.bounds_center - direction * (2.0 * radius) + frame.x * disc.x + frame.y * disc.y;
+            (Ray::new(origin, direction), irradiance * (PI * radius * radius))
+        }
+        LightSource::Area { object, radiance } => {
+            let (point, normal, error) = point_on_emitter(world, object, u1)?;
+            let d = Frame::from_z(normal).to_world(cosine_hemisphere(u2));
+            // Cosine-weighted: L cos θ / (pdf_area · cos θ/π) = π L A
+            let origin = offset_ray_origin(point, error, normal, d);
+            (Ray::new(origin, d), radiance * (PI * emitter_area(world, object)))
+        }
+    };
+    Some(EmittedPhoton { ray, power: power / pick })
+}
+
+/// A uniform point on an emitter: (point, normal, error bound).
+fn point_on_emitter(world: &World, object: u32, u: Vec2) -> Option<(Vec3, Vec3, f32)> {
+    match world.objects[object as usize].shape {
+        ShapeRef::Sphere(i) => {
+            let (center, radius) = (world.spheres.center(i as usize), world.spheres.radius[i as usize]);
+            let normal = uniform_sphere(u);
+            Some((center + normal * radius, normal, crate::geometry::gamma(6) * (center.abs().max_element() + radius)))
+        }
+        ShapeRef::Triangle(t) => {
+            let triangle = &world.triangles[t as usize].0;
+            let (b0, b1) = uniform_triangle(u);
+            let [a, b, c] = triangle.vertices;
+            let error = crate::geometry::gamma(7) * (a.abs() + b.abs() + c.abs()).max_element();
+            Some((a * b0 + b * b1 + c * (1.0 - b0 - b1), triangle.normal, error))
+        }
+        ShapeRef::Plane(_) => None,
+    }
+}
+
+/// Bounding spheres of the specular objects, the targets of caustic photons
+/// (Jensen's projection maps, in their simplest form).
+pub fn specular_targets(world: &World) -> Vec<(Vec3, f32)> {
+    world
+        .objects
+        .iter()
+        .filter(|o| crate::render::bsdf::Bsdf::new(&world.materials[o.material as usize]).is_specular())
+        .filter(|o| !matches!(world.materials[o.material as usize], crate::scene::MaterialModel::Emissive { .. }))
+        .filter_map(|o| match o.shape {
+            ShapeRef::Sphere(i) => Some((world.spheres.center(i as usize), world.spheres.radius[i as usize])),
+            ShapeRef::Triangle(t) => {
+                let [a, b, c] = world.triangles[t as usize].0.vertices;
+                let center = (a + b + c) / 3.0;
+                let radius = (a - center).length().max((b - center).length()).max((c - center).length());
+                Some((center, radius * 1.001))
+            }
+            ShapeRef::Plane(_) => None,
+        })
+        .collect()
+}
+
+/// Emit a photon aimed at one of the specular `targets`: a direction within
+/// the cone a target's bounding sphere subtends from the emission point.
+/// Its power divides by the pdf summed over every cone containing the
+/// direction, so overlapping targets are not counted twice.
+pub fn emit_toward(
+    world: &World,
+    picker: &LightPicker,
+    targets: &[(Vec3, f32)],
+    sampler: &mut Sampler,
+) -> Option<EmittedPhoton> {
+    if targets.is_empty() {
+        return None;
+    }
+    let (index, pick) = picker.pick(sampler.next_f32())?;
+    let light = &world.lights[index];
+    let target = targets[((sampler.next_f32() * targets.len() as f32) as usize).min(targets.len() - 1)];
+    let (u1, u2) = (sampler.next_2d(), sampler.next_2d());
+    let target_pick = 1.0 / targets.len() as f32;
+    // Solid-angle pdf of choosing direction d from `origin`, over all targets
+    let direction_pdf = |origin: Vec3, d: Vec3| -> f32 {
+        targets
+            .iter()
+            .filter_map(|(center, radius)| {
+                let to = *center - origin;
+                let distance2 = to.length_squared();
+                let sin2 = radius * radius / distance2;
+                if sin2 >= 1.0 {
+                    return None;
+                }
+                let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
+                let cos = to.dot(d) / distance2.sqrt();
+                (cos >= 1.0 - one_minus_cos).then(|| uniform_cone_pdf(one_minus_cos) * target_pick)
+            })
+            .sum()
+    };
+    let cone_direction = |origin: Vec3| -> Option<Vec3> {
+        let to = target.0 - origin;
+        let distance2 = to.length_squared();
+        let sin2 = target.1 * target.1 / distance2;
+        if sin2 >= 1.0 {
+            return None;
+        }
+        let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
+        Some(Frame::from_z(to / distance2.sqrt()).to_world(uniform_cone(u2, one_minus_cos)))
+    };
+    let (ray, power) = match *light {
+        LightSource::Point { position, intensity, .. } => {
+            let d = cone_direction(position)?;
+            (Ray::new(position, d), intensity / direction_pdf(position, d))
+        }
+        LightSource::Spot { position, direction, cos_cone, exponent, intensity, .. } => {
+            let d = cone_direction(position)?;
+            let falloff = spot_factor(direction, d, cos_cone, exponent);
+            if falloff == 0.0 {
+                return None;
+            }
+            (Ray::new(position, d), intensity * (falloff / direction_pdf(position, d)))
+        }
+        LightSource::Directional { direction, irradiance } => {
+            // A disc just covering the target, perpendicular to the light
+            let frame = Frame::from_z(direction);
+            let disc = crate::render::sampling::concentric_disk(u1) * target.1;
+            let origin =
+                target.0 - direction * (2.0 * world.bounds_radius.max(target.1)) + frame.x * disc.x + frame.y * disc.y;
+            // Density of origins over all targets' discs containing this line
+            let density: f32 = targets
+                .iter()
+                .filter(|(c, r)| {
+                    let offset = *c - origin;
+                    (offset - direction * offset.dot(direction)).length_squared() <= r * r
+                })
+                .map(|(_, r)| target_pick / (PI * r * r))
+                .sum();
+            (Ray::new(origin, direction), irradiance / density)
+        }
+        LightSource::Area { object, radiance } => {
+            let (point, normal, error) = point_on_emitter(world, object, u1)?;
+            let d = cone_direction(point)?;
+            let cos = normal.dot(d);
+            if cos <= 0.0 {
+                return None;
+            }
+            let origin = offset_ray_origin(point, error, normal, d);
+            let area = emitter_area(world, object);
+            (Ray::new(origin, d), radiance * (cos * area / direction_pdf(point, d)))
+        }
+    };
+    power.is_finite().then_some(EmittedPhoton { ray, power: power / pick })
+}

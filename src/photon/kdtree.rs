@@ -1,0 +1,312 @@
+//! The photon map's kd-tree (Bentley 1975, as Jensen uses it): photons in
+//! one flat array in left-balanced heap order — children of node i at 2i+1
+//! and 2i+2, no pointers — split on the axis of largest extent, built by
+//! linear-time median selection, queried for the k nearest with a bounded
+//! max-heap on squared distances.
+
+use glam::Vec3;
+
+use super::photon::Photon;
+
+pub struct PhotonKdTree {
+    photons: Vec<Photon>,
+    depth: usize,
+}
+
+/// Nodes in the left subtree of a left-balanced tree of `n` nodes: the last
+/// level fills from the left, so the left subtree is complete first.
+fn left_subtree_size(n: usize) -> usize {
+    if n <= 1 {
+        return 0;
+    }
+    let levels = usize::BITS - 1 - n.leading_zeros(); // full levels below the last
+    let full = (1usize << levels) - 1;
+    let last = n - full;
+    let half_last = 1usize << (levels - 1);
+    (full - 1) / 2 + last.min(half_last)
+}
+
+impl PhotonKdTree {
+    /// Balance `photons` into a left-balanced tree in O(n log n).
+    pub fn build(mut photons: Vec<Photon>) -> Self {
+        let n = photons.len();
+        let mut tree = vec![Photon::new(Vec3::ZERO, Vec3::Z, [0.0; 3]); n];
+        // (start, length, heap index): an explicit stack, no recursion
+        let mut stack = Vec::with_capacity(64);
+        if n > 0 {
+            stack.push((0usize, n, 0usize));
+        }
+        while let Some((start, length, node)) = stack.pop() {
+            let segment = &mut photons[start..start + length];
+            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            for p in segment.iter() {
+                lo = lo.min(p.position);
+                hi = hi.max(p.position);
+            }
+            let axis = (hi - lo).max_position();
+            let median = left_subtree_size(length);
+            segment.select_nth_unstable_by(median, |a, b| a.position[axis].total_cmp(&b.position[axis]));
+            let mut photon = segment[median];
+            photon.set_axis(axis);
+            tree[node] = photon;
+            if median > 0 {
+                stack.push((start, median, 2 * node + 1));
+            }
+            if length - median - 1 > 0 {
+                stack.push((start + median + 1, length - median - 1, 2 * node + 2));
+            }
+        }
+        let depth = (usize::BITS - n.leading_zeros()) as usize;
+        Self { photons: tree, depth }
+    }
+
+    /// A tree read back from a file, already in heap order.
+    pub fn from_heap_order(photons: Vec<Photon>) -> Self {
+        let depth = (usize::BITS - photons.len().leading_zeros()) as usize;
+        Self { photons, depth }
+    }
+
+    pub fn len(&self) -> usize {
+        self.photons.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.photons.is_empty()
+    }
+
+    pub fn depth(&self) -> usize {
+        self.depth
+    }
+
+    /// Heap-ordered photons; `Neighbours` indices point here.
+    pub fn photons(&self) -> &[Photon] {
+        &self.photons
+    }
+
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of_val(self.photons.as_slice())
+    }
+
+    /// The `k` nearest photons to `position` within `max_radius` (inclusive)
+    /// into `out`; with a `normal`, only photons arriving at its front side.
+    /// Returns the number of nodes visited.
+    pub fn k_nearest(
+        &self,
+        position: Vec3,
+        normal: Option<Vec3>,
+        k: usize,
+        max_radius: f32,
+        out: &mut Neighbours,
+    ) -> usize {
+        out.reset(k);
+        let n = self.photons.len();
+        if k == 0 || n == 0 || !(max_radius >= 0.0) {
+            return 0;
+        }
+        let photons = &self.photons[..];
+        let mut bound = max_radius * max_radius;
+        let mut visited = 0;
+        let mut stack = [(0u32, 0f32); 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let (start, plane_distance2) = stack[top];
+            // The bound may have shrunk since this subtree was deferred
+            if plane_distance2 > bound {
+                continue;
+            }
+            let mut node = start as usize;
+            loop {
+                visited += 1;
+                let photon = &photons[node];
+                let offset = position - photon.position;
+                let distance2 = offset.length_squared();
+                if distance2 <= bound && normal.is_none_or(|n| photon.incoming_direction().dot(n) < 0.0) {
+                    out.push(distance2, node as u32);
+                    if out.is_full() {
+                        bound = out.max_dist2();
+                    }
+                }
+                let delta = offset[photon.axis()];
+                let (near, far) = if delta < 0.0 { (2 * node + 1, 2 * node + 2) } else { (2 * node + 2, 2 * node + 1) };
+                if far < n && delta * delta <= bound {
+                    stack[top] = (far as u32, delta * delta);
+                    top += 1;
+                }
+                if near >= n {
+                    break;
+                }
+                node = near;
+            }
+        }
+        visited
+    }
+
+    /// Every photon with squared distance ≤ radius² (progressive photon mapping).
+    pub fn for_each_within(&self, position: Vec3, radius: f32, mut f: impl FnMut(&Photon)) {
+        let n = self.photons.len();
+        if n == 0 || !(radius >= 0.0) {
+            return;
+        }
+        let bound = radius * radius;
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let mut node = stack[top] as usize;
+            loop {
+                let photon = &self.photons[node];
+                let offset = position - photon.position;
+                if offset.length_squared() <= bound {
+                    f(photon);
+                }
+                let delta = offset[photon.axis()];
+                let (near, far) = if delta < 0.0 { (2 * node + 1, 2 * node + 2) } else { (2 * node + 2, 2 * node + 1) };
+                if far < n && delta * delta <= bound {
+                    stack[top] = far as u32;
+                    top += 1;
+                }
+                if near >= n {
+                    break;
+                }
+                node = near;
+            }
+        }
+    }
+}
+
+/// A reusable bounded max-heap of (squared distance, photon index): the
+/// farthest of the k best is at the root, ready to be replaced.
+#[derive(Clone, Debug, Default)]
+pub struct Neighbours {
+    heap: Vec<(f32, u32)>,
+    k: usize,
+}
+
+impl Neighbours {
+    pub fn new(k: usize) -> Self {
+        Self { heap: Vec::with_capacity(k), k }
+    }
+
+    fn reset(&mut self, k: usize) {
+        self.heap.clear();
+        self.k = k;
+    }
+
+    pub fn len(&self) -> usize {
+        self.heap.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.heap.is_empty()
+    }
+
+    #[inline]
+    fn is_full(&self) -> bool {
+        self.heap.len() >= self.k
+    }
+
+    /// Squared distance of the farthest kept photon (0 when empty).
+    #[inline]
+    pub fn max_dist2(&self) -> f32 {
+        self.heap.first().map_or(0.0, |e| e.0)
+    }
+
+    pub fn as_slice(&self) -> &[(f32, u32)] {
+        &self.heap
+    }
+
+    #[inline]
+    fn push(&mut self, distance2: f32, index: u32) {
+        let heap = &mut self.heap;
+        if heap.len() < self.k {
+            // Sift up
+            heap.push((distance2, index));
+            let mut i = heap.len() - 1;
+            while i > 0 {
+                let parent = (i - 1) / 2;
+                if heap[parent].0 >= heap[i].0 {
+                    break;
+                }
+                heap.swap(parent, i);
+                i = parent;
+            }
+        } else if distance2 < heap[0].0 {
+            // Replace the farthest, sift down
+            let len = heap.len();
+            let mut i = 0;
+            loop {
+                let left = 2 * i + 1;
+                if left >= len {
+                    break;
+                }
+                let right = left + 1;
+                let child = if right < len && heap[right].0 > heap[left].0 { right } else { left };
+                if heap[child].0 <= distance2 {
+                    break;
+                }
+                heap[i] = heap[child];
+                i = child;
+            }
+            heap[i] = (distance2, index);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::rng::Sampler;
+
+    fn random_photons(n: usize, seed: u64) -> Vec<Photon> {
+        let mut s = Sampler::new(0, 0, seed);
+        (0..n)
+            .map(|_| {
+                let p = Vec3::new(s.next_f32() * 4.0, s.next_f32(), s.next_f32() * 2.0);
+                Photon::new(p, -Vec3::Y, [1.0; 3])
+            })
+            .collect()
+    }
+
+    /// Heap order and split planes: every photon in node i's left subtree is
+    /// ≤ node i on its axis, every one in its right subtree ≥, and the axis
+    /// is the subtree's largest extent.
+    #[test]
+    fn split_planes_and_axes_hold_for_every_node() {
+        for n in [1, 2, 3, 7, 8, 100, 1000, 1023, 1024] {
+            let tree = PhotonKdTree::build(random_photons(n, n as u64));
+            let photons = tree.photons();
+            assert_eq!(photons.len(), n);
+            assert_eq!(tree.depth(), (n as f64 + 1.0).log2().ceil() as usize);
+            fn subtree(i: usize, n: usize, out: &mut Vec<usize>) {
+                if i < n {
+                    out.push(i);
+                    subtree(2 * i + 1, n, out);
+                    subtree(2 * i + 2, n, out);
+                }
+            }
+            for i in 0..n {
+                let axis = photons[i].axis();
+                let v = photons[i].position[axis];
+                let (mut left, mut right, mut all) = (Vec::new(), Vec::new(), Vec::new());
+                subtree(2 * i + 1, n, &mut left);
+                subtree(2 * i + 2, n, &mut right);
+                subtree(i, n, &mut all);
+                assert!(left.iter().all(|&j| photons[j].position[axis] <= v));
+                assert!(right.iter().all(|&j| photons[j].position[axis] >= v));
+                let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+                for &j in &all {
+                    lo = lo.min(photons[j].position);
+                    hi = hi.max(photons[j].position);
+                }
+                let extent = hi - lo;
+                assert_eq!(extent[axis], extent.max_element(), "node {i} of {n}");
+            }
+        }
+    }
+
+    #[test]
+    fn left_subtree_sizes() {
+        assert_eq!([1, 2, 3, 4, 5, 6, 7, 8].map(left_subtree_size), [0, 1, 1, 2, 3, 3, 3, 4]);
+    }
+}

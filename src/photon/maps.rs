@@ -1,0 +1,151 @@
+//! Jensen's two photon maps, their statistics, and the radiance estimate.
+
+use std::f32::consts::PI;
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+
+use super::kdtree::{Neighbours, PhotonKdTree};
+use super::trace::{trace_photons, MapKind};
+use crate::render::bsdf::Bsdf;
+use crate::render::world::World;
+use crate::render::PhotonSettings;
+use crate::scene::Rgb;
+
+/// Jensen: an estimate from fewer photons than this is noise, not density.
+pub const MIN_PHOTONS: usize = 8;
+pub const RADIUS_BINS: usize = 16;
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MapStats {
+    pub emitted: u64,
+    pub stored: u64,
+    pub bytes: u64,
+    pub trace_time: Duration,
+    pub build_time: Duration,
+    pub depth: u32,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhotonMapStats {
+    pub global: MapStats,
+    pub caustic: MapStats,
+}
+
+/// k-NN work done while rendering, summed per pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct QueryStats {
+    pub queries: u64,
+    pub nodes_visited: u64,
+    pub time: Duration,
+    /// Gather radii as fractions of the maximum radius, in equal bins.
+    pub radius_histogram: [u64; RADIUS_BINS],
+}
+
+impl QueryStats {
+    pub fn add(&mut self, other: &QueryStats) {
+        self.queries += other.queries;
+        self.nodes_visited += other.nodes_visited;
+        self.time += other.time;
+        for (a, b) in self.radius_histogram.iter_mut().zip(other.radius_histogram) {
+            *a += b;
+        }
+    }
+
+    pub fn mean_nodes_visited(&self) -> f64 {
+        self.nodes_visited as f64 / self.queries.max(1) as f64
+    }
+
+    pub fn mean_query_time(&self) -> Duration {
+        self.time / self.queries.max(1) as u32
+    }
+}
+
+/// The global and caustic maps of one scene and photon settings.
+pub struct PhotonMaps {
+    pub global: PhotonKdTree,
+    pub caustic: PhotonKdTree,
+    pub stats: PhotonMapStats,
+    /// Largest gather radius (resolved from the settings and the scene).
+    pub max_radius: f32,
+}
+
+/// The gather radius when the settings leave it to the scene: a few percent
+/// of the finite geometry's size.
+pub fn resolve_max_radius(world: &World, settings: &PhotonSettings) -> f32 {
+    if settings.max_radius > 0.0 {
+        settings.max_radius
+    } else {
+        (world.bounds_radius * 0.05).max(1e-4)
+    }
+}
+
+impl PhotonMaps {
+    pub fn build(world: &World, settings: &PhotonSettings, seed: u64, max_depth: u32) -> Self {
+        let build = |kind: MapKind, count: u32| -> (PhotonKdTree, MapStats) {
+            let start = Instant::now();
+            let photons = trace_photons(world, kind, count as u64, 0, seed, max_depth);
+            let trace_time = start.elapsed();
+            let start = Instant::now();
+            let tree = PhotonKdTree::build(photons);
+            let stats = MapStats {
+                emitted: count as u64,
+                stored: tree.len() as u64,
+                bytes: tree.bytes() as u64,
+                trace_time,
+                build_time: start.elapsed(),
+                depth: tree.depth() as u32,
+            };
+            (tree, stats)
+        };
+        let (global, global_stats) = build(MapKind::Global, settings.global_photons);
+        let (caustic, caustic_stats) = build(MapKind::Caustic, settings.caustic_photons);
+        Self {
+            global,
+            caustic,
+            stats: PhotonMapStats { global: global_stats, caustic: caustic_stats },
+            max_radius: resolve_max_radius(world, settings),
+        }
+    }
+}
+
+/// Reflected radiance from a photon map at a surface point:
+/// Σ f·Φ / (π r²), `r` the distance to the k-th photon, or the maximum
+/// radius when fewer were found (then all photons within it are in the sum).
+/// (The thesis divides by 2π r², a factor of two too small: the photons are
+/// counted on a disc of area π r², not a hemisphere.)
+#[allow(clippy::too_many_arguments)]
+pub fn estimate(
+    tree: &PhotonKdTree,
+    point: Vec3,
+    normal: Vec3,
+    wo: Vec3,
+    bsdf: &Bsdf,
+    k: usize,
+    max_radius: f32,
+    neighbours: &mut Neighbours,
+    stats: &mut QueryStats,
+) -> Rgb {
+    if tree.is_empty() {
+        return Rgb::ZERO;
+    }
+    let start = Instant::now();
+    let visited = tree.k_nearest(point, Some(normal), k, max_radius, neighbours);
+    stats.queries += 1;
+    stats.nodes_visited += visited as u64;
+    let found = neighbours.len();
+    let radius2 = if found >= k { neighbours.max_dist2() } else { max_radius * max_radius };
+    let bin = ((radius2.sqrt() / max_radius) * RADIUS_BINS as f32) as usize;
+    stats.radius_histogram[bin.min(RADIUS_BINS - 1)] += 1;
+    let mut sum = Rgb::ZERO;
+    if found >= MIN_PHOTONS && radius2 > 0.0 {
+        let photons = tree.photons();
+        for &(_, index) in neighbours.as_slice() {
+            let photon = &photons[index as usize];
+            sum += bsdf.eval(wo, -photon.incoming_direction(), normal) * Vec3::from_array(photon.power);
+        }
+        sum /= PI * radius2;
+    }
+    stats.time += start.elapsed();
+    sum
+}

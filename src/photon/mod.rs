@@ -1,0 +1,13 @@
+//! Photon mapping (part of the render layer): photons traced from the lights
+//! into Jensen's global and caustic maps on our own kd-tree, radiance
+//! estimates from them, and stochastic progressive photon mapping.
+
+pub mod emit;
+pub mod kdtree;
+pub mod maps;
+pub mod photon;
+pub mod trace;
+
+pub use kdtree::{Neighbours, PhotonKdTree};
+pub use maps::{PhotonMapStats, PhotonMaps, QueryStats};
+pub use photon::Photon;

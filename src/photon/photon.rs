@@ -1,0 +1,130 @@
+//! The photon record: 28 bytes — position (12), RGB power (12), incoming
+//! direction packed in two bytes as Jensen does (θ, φ quantised to 256
+//! steps), and the kd-tree's split axis.
+
+use std::f32::consts::PI;
+use std::sync::OnceLock;
+
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct Photon {
+    pub position: Vec3,
+    pub power: [f32; 3],
+    theta: u8,
+    phi: u8,
+    axis: u8,
+    _pad: u8,
+}
+
+/// cos θ, sin θ, cos φ, sin φ at the centres of the 256 quantisation steps.
+struct DirectionTables {
+    cos_theta: [f32; 256],
+    sin_theta: [f32; 256],
+    cos_phi: [f32; 256],
+    sin_phi: [f32; 256],
+}
+
+fn tables() -> &'static DirectionTables {
+    static TABLES: OnceLock<DirectionTables> = OnceLock::new();
+    TABLES.get_or_init(|| {
+        let mut t =
+            DirectionTables { cos_theta: [0.0; 256], sin_theta: [0.0; 256], cos_phi: [0.0; 256], sin_phi: [0.0; 256] };
+        for i in 0..256 {
+            let theta = (i as f32 + 0.5) * (PI / 256.0);
+            let phi = (i as f32 + 0.5) * (2.0 * PI / 256.0);
+            t.cos_theta[i] = theta.cos();
+            t.sin_theta[i] = theta.sin();
+            t.cos_phi[i] = phi.cos();
+            t.sin_phi[i] = phi.sin();
+        }
+        t
+    })
+}
+
+impl Photon {
+    /// `incoming_direction`: the unit direction the photon travels.
+    pub fn new(position: Vec3, incoming_direction: Vec3, power: [f32; 3]) -> Self {
+        let d = incoming_direction;
+        let theta = (d.z.clamp(-1.0, 1.0).acos() * (256.0 / PI)) as i32;
+        let mut phi = d.y.atan2(d.x) * (256.0 / (2.0 * PI));
+        if phi < 0.0 {
+            phi += 256.0;
+        }
+        Self {
+            position,
+            power,
+            theta: theta.clamp(0, 255) as u8,
+            phi: (phi as i32).clamp(0, 255) as u8,
+            axis: 0,
+            _pad: 0,
+        }
+    }
+
+    #[inline]
+    pub fn incoming_direction(&self) -> Vec3 {
+        let t = tables();
+        let (ti, pi) = (self.theta as usize, self.phi as usize);
+        Vec3::new(t.sin_theta[ti] * t.cos_phi[pi], t.sin_theta[ti] * t.sin_phi[pi], t.cos_theta[ti])
+    }
+
+    #[inline]
+    pub fn axis(&self) -> usize {
+        self.axis as usize
+    }
+
+    #[inline]
+    pub(super) fn set_axis(&mut self, axis: usize) {
+        self.axis = axis as u8;
+    }
+
+    /// Little-endian bytes for photon-map files.
+    pub fn to_bytes(&self) -> [u8; 28] {
+        let mut out = [0u8; 28];
+        for (i, v) in self.position.to_array().into_iter().chain(self.power).enumerate() {
+            out[i * 4..i * 4 + 4].copy_from_slice(&v.to_le_bytes());
+        }
+        out[24] = self.theta;
+        out[25] = self.phi;
+        out[26] = self.axis;
+        out
+    }
+
+    pub fn from_bytes(bytes: &[u8; 28]) -> Self {
+        let f = |i: usize| f32::from_le_bytes([bytes[i * 4], bytes[i * 4 + 1], bytes[i * 4 + 2], bytes[i * 4 + 3]]);
+        Self {
+            position: Vec3::new(f(0), f(1), f(2)),
+            power: [f(3), f(4), f(5)],
+            theta: bytes[24],
+            phi: bytes[25],
+            axis: bytes[26].min(2),
+            _pad: 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::rng::Sampler;
+    use crate::render::sampling::uniform_sphere;
+
+    #[test]
+    fn photon_is_28_bytes() {
+        assert_eq!(std::mem::size_of::<Photon>(), 28);
+    }
+
+    #[test]
+    fn direction_survives_packing_within_one_step() {
+        // One θ step is π/256; φ steps shrink toward the poles, so compare angles
+        let tolerance = (2.0 * PI / 256.0).cos();
+        let mut s = Sampler::new(0, 0, 4);
+        let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+        for d in axes.into_iter().chain((0..10_000).map(|_| uniform_sphere(s.next_2d()))) {
+            let p = Photon::new(Vec3::ZERO, d, [1.0; 3]);
+            assert!(p.incoming_direction().dot(d) > tolerance, "{d} → {}", p.incoming_direction());
+            assert_eq!(Photon::from_bytes(&p.to_bytes()), p);
+        }
+    }
+}

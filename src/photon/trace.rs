@@ -1,0 +1,119 @@
+//! Photon tracing: photons leave the lights, bounce by their surfaces' BSDFs
+//! with Russian roulette at diffuse surfaces, and are stored at non-specular
+//! hits according to which map they are for. Photon i's random stream is
+//! fixed by (i, pass, seed), and chunks are joined in order, so the maps do
+//! not depend on the thread count.
+
+use rayon::prelude::*;
+
+use super::emit::{emit, emit_toward, specular_targets, EmittedPhoton, LightPicker};
+use super::photon::Photon;
+use crate::render::bsdf::{Bsdf, Transport};
+use crate::render::rng::Sampler;
+use crate::render::world::World;
+
+/// Which photons a map keeps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapKind {
+    /// Jensen's global map for indirect light: stores after at least one
+    /// diffuse bounce (direct light is sampled, caustics have their own map).
+    Global,
+    /// Light → one or more specular bounces → the first diffuse surface.
+    Caustic,
+    /// SPPM: every non-specular hit but the first (direct light is sampled).
+    Indirect,
+}
+
+const CHUNK: u64 = 4096;
+/// Keeps photon streams apart from camera streams with the same indices.
+const PHOTON_SALT: u64 = 0x5eed_f07f_0000_0001;
+
+/// Trace `count` photons for `kind`; stored powers are divided by `count`.
+pub fn trace_photons(world: &World, kind: MapKind, count: u64, pass: u64, seed: u64, max_depth: u32) -> Vec<Photon> {
+    let picker = LightPicker::new(world);
+    if picker.is_empty() || count == 0 {
+        return Vec::new();
+    }
+    let targets = if kind == MapKind::Caustic { specular_targets(world) } else { Vec::new() };
+    if kind == MapKind::Caustic && targets.is_empty() {
+        return Vec::new();
+    }
+    let scale = 1.0 / count as f32;
+    let chunks = count.div_ceil(CHUNK);
+    let per_chunk: Vec<Vec<Photon>> = (0..chunks)
+        .into_par_iter()
+        .map(|chunk| {
+            let mut stored = Vec::new();
+            for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(count) {
+                let mut sampler = Sampler::new(index, pass, seed ^ PHOTON_SALT ^ kind as u64);
+                let emitted = match kind {
+                    MapKind::Caustic => emit_toward(world, &picker, &targets, &mut sampler),
+                    _ => emit(world, &picker, &mut sampler),
+                };
+                if let Some(photon) = emitted {
+                    trace_one(world, kind, photon, scale, max_depth, &mut sampler, &mut stored);
+                }
+            }
+            stored
+        })
+        .collect();
+    per_chunk.concat()
+}
+
+fn trace_one(
+    world: &World,
+    kind: MapKind,
+    emitted: EmittedPhoton,
+    scale: f32,
+    max_depth: u32,
+    sampler: &mut Sampler,
+    stored: &mut Vec<Photon>,
+) {
+    let EmittedPhoton { mut ray, mut power } = emitted;
+    power *= scale;
+    let mut diffuse_bounces = 0;
+    for depth in 0..max_depth {
+        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+            return;
+        };
+        let bsdf = Bsdf::new(world.material_of(&hit));
+        if !bsdf.is_specular() {
+            let keep = match kind {
+                MapKind::Global => diffuse_bounces > 0,
+                MapKind::Caustic => depth > 0,
+                MapKind::Indirect => depth > 0,
+            };
+            if keep && power.is_finite() {
+                stored.push(Photon::new(hit.surface.point, ray.direction, power.to_array()));
+            }
+            if kind == MapKind::Caustic {
+                return;
+            }
+        }
+        let Some(scattered) = bsdf.sample(
+            -ray.direction,
+            hit.surface.normal,
+            sampler.next_f32(),
+            sampler.next_2d(),
+            Transport::Importance,
+        ) else {
+            return;
+        };
+        if !scattered.delta {
+            if kind == MapKind::Caustic {
+                return;
+            }
+            diffuse_bounces += 1;
+            // Russian roulette with the surface's reflectance: survivors carry
+            // the absorbed photons' share
+            let survive = scattered.weight.max_element().min(1.0);
+            if survive <= 0.0 || sampler.next_f32() >= survive {
+                return;
+            }
+            power *= scattered.weight / survive;
+        } else {
+            power *= scattered.weight;
+        }
+        ray = hit.surface.spawn_ray(scattered.wi);
+    }
+}
