@@ -38,7 +38,7 @@ fn path_smallpt(c: &mut Criterion) {
         samples_per_pixel: Some(4),
         ..RenderSettings::for_algorithm(Algorithm::Path)
     };
-    let job = RenderJob { scene, settings };
+    let job = RenderJob::new(scene, settings);
     let mut group = c.benchmark_group("render");
     group.sample_size(10);
     group.throughput(Throughput::Elements(512 * 384 * 4));

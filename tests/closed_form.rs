@@ -33,7 +33,7 @@ fn render(scene: gi_studio::scene::Scene, algorithm: Algorithm, spp: u32) -> gi_
         samples_per_pixel: Some(spp),
         ..RenderSettings::for_algorithm(algorithm)
     };
-    render_blocking(&RenderJob { scene: Arc::new(scene), settings }).expect("renders").0
+    render_blocking(&RenderJob::new(Arc::new(scene), settings)).expect("renders").0
 }
 
 #[test]

@@ -17,7 +17,7 @@ fn job(name: &str, algorithm: Algorithm, width: u32, height: u32, spp: u32, thre
         seed: 11,
         ..RenderSettings::for_algorithm(algorithm)
     };
-    RenderJob { scene: Arc::new(scene), settings }
+    RenderJob::new(Arc::new(scene), settings)
 }
 
 #[test]

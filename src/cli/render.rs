@@ -72,7 +72,7 @@ pub fn render_with_progress(scene: Scene, settings: RenderSettings) -> Result<(c
     bar.enable_steady_tick(Duration::from_millis(200));
     let timed = settings.time_limit.is_some();
     let session = RenderSession::new(None);
-    let generation = session.start(RenderJob { scene: Arc::new(scene), settings });
+    let generation = session.start(RenderJob::new(Arc::new(scene), settings));
     let result = loop {
         let Ok(event) = session.events().recv() else {
             bail!("the render worker stopped unexpectedly");
@@ -89,7 +89,7 @@ pub fn render_with_progress(scene: Scene, settings: RenderSettings) -> Result<(c
                 break (Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone()), stats)
             }
             RenderEvent::Failed { message, .. } => bail!("{message}"),
-            RenderEvent::Started { .. } | RenderEvent::Tile(_) => {}
+            RenderEvent::Started { .. } | RenderEvent::Tile(_) | RenderEvent::PhotonMaps { .. } => {}
         }
     };
     bar.finish_and_clear();

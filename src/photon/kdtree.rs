@@ -8,6 +8,7 @@ use glam::Vec3;
 
 use super::photon::Photon;
 
+#[derive(Debug)]
 pub struct PhotonKdTree {
     photons: Vec<Photon>,
     depth: usize,

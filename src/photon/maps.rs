@@ -12,7 +12,7 @@ use crate::render::world::World;
 use crate::render::PhotonSettings;
 use crate::scene::Rgb;
 
-/// Jensen: an estimate from fewer photons than this is noise, not density.
+/// Jensen: a k below this makes the estimate noise, not density.
 pub const MIN_PHOTONS: usize = 8;
 pub const RADIUS_BINS: usize = 16;
 
@@ -62,6 +62,7 @@ impl QueryStats {
 }
 
 /// The global and caustic maps of one scene and photon settings.
+#[derive(Debug)]
 pub struct PhotonMaps {
     pub global: PhotonKdTree,
     pub caustic: PhotonKdTree,
@@ -110,8 +111,9 @@ impl PhotonMaps {
 }
 
 /// Reflected radiance from a photon map at a surface point:
-/// Σ f·Φ / (π r²), `r` the distance to the k-th photon, or the maximum
-/// radius when fewer were found (then all photons within it are in the sum).
+/// Σ f·Φ / (π r²) over the k ≥ 8 nearest photons, `r` the distance to the
+/// k-th, or the maximum radius when fewer lie within it (then every photon in
+/// that disc is in the sum, and the disc is the right area).
 /// (The thesis divides by 2π r², a factor of two too small: the photons are
 /// counted on a disc of area π r², not a hemisphere.)
 #[allow(clippy::too_many_arguments)]
@@ -134,11 +136,12 @@ pub fn estimate(
     stats.queries += 1;
     stats.nodes_visited += visited as u64;
     let found = neighbours.len();
+    debug_assert!(k >= MIN_PHOTONS);
     let radius2 = if found >= k { neighbours.max_dist2() } else { max_radius * max_radius };
     let bin = ((radius2.sqrt() / max_radius) * RADIUS_BINS as f32) as usize;
     stats.radius_histogram[bin.min(RADIUS_BINS - 1)] += 1;
     let mut sum = Rgb::ZERO;
-    if found >= MIN_PHOTONS && radius2 > 0.0 {
+    if found > 0 && radius2 > 0.0 {
         let photons = tree.photons();
         for &(_, index) in neighbours.as_slice() {
             let photon = &photons[index as usize];

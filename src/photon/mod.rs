@@ -3,9 +3,11 @@
 //! estimates from them, and stochastic progressive photon mapping.
 
 pub mod emit;
+pub mod integrator;
 pub mod kdtree;
 pub mod maps;
 pub mod photon;
+pub mod sppm;
 pub mod trace;
 
 pub use kdtree::{Neighbours, PhotonKdTree};

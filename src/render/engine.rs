@@ -19,6 +19,11 @@ use super::settings::{Algorithm, RenderSettings};
 use super::tiles::{tile_layout, TileAccumulator, TileRect};
 use super::world::World;
 use super::{path, whitted, Counters};
+use crate::geometry::Ray;
+use crate::photon::integrator::{PhotonRenderer, PhotonScratch};
+use crate::photon::sppm::camera_pass;
+use crate::photon::trace::{trace_photons, MapKind};
+use crate::photon::{PhotonKdTree, PhotonMapStats, PhotonMaps, QueryStats};
 use crate::scene::{Rgb, Scene};
 
 /// A scene snapshot and how to render it.
@@ -26,6 +31,15 @@ use crate::scene::{Rgb, Scene};
 pub struct RenderJob {
     pub scene: Arc<Scene>,
     pub settings: RenderSettings,
+    /// Photon maps made earlier for this scene and these settings (loaded
+    /// from a file); traced afresh when absent.
+    pub photon_maps: Option<Arc<PhotonMaps>>,
+}
+
+impl RenderJob {
+    pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Self {
+        Self { scene, settings, photon_maps: None }
+    }
 }
 
 /// Totals after a pass.
@@ -40,6 +54,20 @@ pub struct PassStats {
     pub rays: u64,
     /// Samples that came out NaN or infinite and were dropped.
     pub non_finite: u64,
+    /// Photon work of the last pass (photon mapping and SPPM).
+    pub photon: PhotonPassStats,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhotonPassStats {
+    /// k-NN queries made while rendering the pass.
+    pub queries: QueryStats,
+    /// SPPM: photons traced and stored this pass, and the time it took.
+    pub photons_traced: u64,
+    pub photons_stored: u64,
+    pub trace_time: Duration,
+    /// SPPM: mean gather radius over pixels after the pass.
+    pub mean_radius: f32,
 }
 
 impl PassStats {
@@ -66,11 +94,30 @@ pub struct TileUpdate {
 /// job) it belongs to, so stale ones can be dropped.
 #[derive(Clone, Debug)]
 pub enum RenderEvent {
-    Started { generation: u64, width: u32, height: u32 },
+    Started {
+        generation: u64,
+        width: u32,
+        height: u32,
+    },
     Tile(TileUpdate),
-    PassFinished { generation: u64, stats: PassStats },
-    Finished { generation: u64, image: Arc<LinearImage>, stats: PassStats },
-    Failed { generation: u64, message: String },
+    /// Photon mapping traced (or loaded) its maps.
+    PhotonMaps {
+        generation: u64,
+        stats: PhotonMapStats,
+    },
+    PassFinished {
+        generation: u64,
+        stats: PassStats,
+    },
+    Finished {
+        generation: u64,
+        image: Arc<LinearImage>,
+        stats: PassStats,
+    },
+    Failed {
+        generation: u64,
+        message: String,
+    },
 }
 
 impl RenderEvent {
@@ -78,6 +125,7 @@ impl RenderEvent {
         match self {
             RenderEvent::Started { generation, .. }
             | RenderEvent::PassFinished { generation, .. }
+            | RenderEvent::PhotonMaps { generation, .. }
             | RenderEvent::Finished { generation, .. }
             | RenderEvent::Failed { generation, .. } => *generation,
             RenderEvent::Tile(tile) => tile.generation,
@@ -228,13 +276,35 @@ fn run_job(context: &JobContext, job: &RenderJob) {
         context.send(RenderEvent::Failed { generation, message: "image size must be at least 1×1".into() });
         return;
     }
+    let world = World::new(&job.scene);
+    let start = Instant::now();
+    let method = match settings.algorithm {
+        Algorithm::Whitted | Algorithm::Path => Method::Sample,
+        Algorithm::Photon => {
+            let maps = match &job.photon_maps {
+                Some(maps) => maps.clone(),
+                None => Arc::new(PhotonMaps::build(&world, &settings.photon, settings.seed, settings.max_depth)),
+            };
+            if !context.is_current() {
+                return;
+            }
+            context.send(RenderEvent::PhotonMaps { generation, stats: maps.stats });
+            Method::Photon(maps)
+        }
+        Algorithm::Sppm => Method::Sppm,
+    };
     let frame = FrameContext {
-        world: World::new(&job.scene),
         camera: CameraModel::new(&job.scene.camera, settings.width, settings.height),
+        sppm_initial_radius: if settings.photon.sppm_initial_radius > 0.0 {
+            settings.photon.sppm_initial_radius
+        } else {
+            (world.bounds_radius * 0.02).max(1e-4)
+        },
+        world,
+        method,
         settings,
     };
     context.send(RenderEvent::Started { generation, width: settings.width, height: settings.height });
-    let start = Instant::now();
     let tiles = tile_layout(settings.width, settings.height, settings.tile_size);
 
     if settings.preview {
@@ -246,9 +316,8 @@ fn run_job(context: &JobContext, job: &RenderJob) {
         });
     }
 
-    let mut buffers: Vec<TileAccumulator> = tiles.iter().map(|r| TileAccumulator::new(*r)).collect();
-    let rays = AtomicU64::new(0);
-    let non_finite = AtomicU64::new(0);
+    let sppm = matches!(frame.method, Method::Sppm);
+    let mut buffers: Vec<TileAccumulator> = tiles.iter().map(|r| TileAccumulator::new(*r, sppm)).collect();
     let mut stats = PassStats::default();
     loop {
         let done_spp = settings.samples_per_pixel.is_some_and(|spp| stats.passes >= spp);
@@ -259,26 +328,43 @@ fn run_job(context: &JobContext, job: &RenderJob) {
         }
         let pass_start = Instant::now();
         let pass = stats.passes;
-        buffers.par_iter_mut().for_each(|buffer| {
-            if !context.is_current() {
-                return;
+        let mut photon = PhotonPassStats::default();
+        let per_tile: Vec<Counters> = if sppm {
+            match frame.sppm_pass(context, &mut buffers, pass, &mut photon) {
+                Some(counters) => counters,
+                None => return,
             }
-            let mut counters = Counters::default();
-            frame.render_tile_pass(buffer, pass, &mut counters);
-            rays.fetch_add(counters.rays, Ordering::Relaxed);
-            non_finite.fetch_add(counters.non_finite, Ordering::Relaxed);
-            let pixels = buffer.mean();
-            context.send(RenderEvent::Tile(TileUpdate { generation, rect: buffer.rect, pixels, preview: false }));
-        });
+        } else {
+            buffers
+                .par_iter_mut()
+                .map(|buffer| {
+                    let mut counters = Counters::default();
+                    if context.is_current() {
+                        frame.render_tile_pass(buffer, pass, &mut counters);
+                        context.send(RenderEvent::Tile(TileUpdate {
+                            generation,
+                            rect: buffer.rect,
+                            pixels: buffer.mean(),
+                            preview: false,
+                        }));
+                    }
+                    counters
+                })
+                .collect()
+        };
         if !context.is_current() {
             return;
         }
+        for counters in &per_tile {
+            stats.rays += counters.rays;
+            stats.non_finite += counters.non_finite;
+            photon.queries.add(&counters.queries);
+        }
         stats.passes += 1;
         stats.samples += settings.width as u64 * settings.height as u64;
-        stats.rays = rays.load(Ordering::Relaxed);
-        stats.non_finite = non_finite.load(Ordering::Relaxed);
         stats.pass_time = pass_start.elapsed();
         stats.elapsed = start.elapsed();
+        stats.photon = photon;
         context.send(RenderEvent::PassFinished { generation, stats });
     }
     let image = assemble(settings.width, settings.height, &buffers);
@@ -297,62 +383,194 @@ fn assemble(width: u32, height: u32, buffers: &[TileAccumulator]) -> LinearImage
     image
 }
 
+/// How a pass turns into pixels.
+enum Method {
+    /// Whitted and path tracing: independent samples per pixel, averaged.
+    Sample,
+    /// Photon mapping: samples per pixel against fixed maps.
+    Photon(Arc<PhotonMaps>),
+    /// SPPM: visible points, a photon pass, and a per-pixel update.
+    Sppm,
+}
+
 /// Everything a pass reads: shared, immutable, built once per job.
 struct FrameContext<'a> {
     world: World,
     camera: CameraModel,
+    method: Method,
+    sppm_initial_radius: f32,
     settings: &'a RenderSettings,
 }
 
 impl FrameContext<'_> {
-    /// One camera sample of pixel (x, y): jittered within the pixel, the
-    /// stream fixed by (pixel, sample, seed).
-    fn sample(&self, x: u32, y: u32, sample: u64, counters: &mut Counters) -> Option<Rgb> {
-        let settings = self.settings;
-        let pixel = y as u64 * settings.width as u64 + x as u64;
-        let mut sampler = Sampler::new(pixel, sample, settings.seed);
+    /// The camera ray of one sample of pixel (x, y): jittered within the
+    /// pixel, its stream fixed by (pixel, sample, seed).
+    fn camera_ray(&self, x: u32, y: u32, sample: u64) -> (Ray, Sampler) {
+        let pixel = y as u64 * self.settings.width as u64 + x as u64;
+        let mut sampler = Sampler::new(pixel, sample, self.settings.seed);
         let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
         let ray = self.camera.generate_ray(film, sampler.next_2d());
-        let value = match settings.algorithm {
-            Algorithm::Whitted => {
+        (ray, sampler)
+    }
+
+    /// One finite, non-negative sample (clamped only if asked), or None.
+    fn sample(
+        &self,
+        x: u32,
+        y: u32,
+        sample: u64,
+        counters: &mut Counters,
+        scratch: &mut Option<PhotonScratch>,
+    ) -> Option<Rgb> {
+        let settings = self.settings;
+        let (ray, mut sampler) = self.camera_ray(x, y, sample);
+        let value = match (&self.method, scratch) {
+            (Method::Photon(maps), Some(scratch)) => {
+                let renderer = PhotonRenderer {
+                    world: &self.world,
+                    maps,
+                    settings: &settings.photon,
+                    max_depth: settings.max_depth,
+                };
+                renderer.radiance(&ray, &mut sampler, counters, scratch)
+            }
+            _ if settings.algorithm == Algorithm::Whitted => {
                 whitted::radiance(&self.world, &ray, settings.max_depth.max(1), 1.0, &mut sampler, counters)
             }
-            Algorithm::Path | Algorithm::Photon | Algorithm::Sppm => {
-                path::radiance(&self.world, &ray, settings.max_depth, &mut sampler, counters)
-            }
+            _ => path::radiance(&self.world, &ray, settings.max_depth, &mut sampler, counters),
         };
+        self.finite(value, counters)
+    }
+
+    fn finite(&self, value: Rgb, counters: &mut Counters) -> Option<Rgb> {
         if !value.is_finite() {
             counters.non_finite += 1;
             return None;
         }
         let value = value.max(Rgb::ZERO);
-        Some(if settings.firefly_clamp > 0.0 { value.min(Rgb::splat(settings.firefly_clamp)) } else { value })
+        let clamp = self.settings.firefly_clamp;
+        Some(if clamp > 0.0 { value.min(Rgb::splat(clamp)) } else { value })
+    }
+
+    fn scratch(&self) -> Option<PhotonScratch> {
+        matches!(self.method, Method::Photon(_))
+            .then(|| PhotonScratch::new(self.settings.photon.k_nearest.max(8) as usize))
     }
 
     fn render_tile_pass(&self, buffer: &mut TileAccumulator, pass: u32, counters: &mut Counters) {
         let rect = buffer.rect;
+        let mut scratch = self.scratch();
         for row in 0..rect.height {
             for column in 0..rect.width {
-                let value = self.sample(rect.x + column, rect.y + row, pass as u64, counters).unwrap_or(Rgb::ZERO);
+                let value = self
+                    .sample(rect.x + column, rect.y + row, pass as u64, counters, &mut scratch)
+                    .unwrap_or(Rgb::ZERO);
                 let sum = &mut buffer.sums[(row * rect.width + column) as usize];
                 for c in 0..3 {
                     sum[c] += value[c] as f64;
                 }
             }
         }
+        if let Some(scratch) = scratch {
+            counters.queries.add(&scratch.queries);
+        }
         buffer.samples += 1;
+    }
+
+    /// One SPPM pass: visible points for every pixel, this pass's photons,
+    /// then each pixel's update. None if the job was abandoned.
+    fn sppm_pass(
+        &self,
+        context: &JobContext,
+        buffers: &mut [TileAccumulator],
+        pass: u32,
+        stats: &mut PhotonPassStats,
+    ) -> Option<Vec<Counters>> {
+        let settings = self.settings;
+        let mut per_tile: Vec<Counters> = buffers
+            .par_iter_mut()
+            .map(|buffer| {
+                let mut counters = Counters::default();
+                if !context.is_current() {
+                    return counters;
+                }
+                let rect = buffer.rect;
+                for (i, pixel) in buffer.sppm.iter_mut().enumerate() {
+                    let (x, y) = (rect.x + i as u32 % rect.width, rect.y + i as u32 / rect.width);
+                    let (ray, mut sampler) = self.camera_ray(x, y, pass as u64);
+                    let (direct, visible) =
+                        camera_pass(&self.world, &ray, settings.max_depth, &mut sampler, &mut counters);
+                    pixel.direct += self.finite(direct, &mut counters).unwrap_or(Rgb::ZERO);
+                    pixel.visible = visible;
+                    if pixel.radius == 0.0 {
+                        pixel.radius = self.sppm_initial_radius;
+                    }
+                }
+                counters
+            })
+            .collect();
+        if !context.is_current() {
+            return None;
+        }
+        let trace_start = Instant::now();
+        let count = settings.photon.sppm_photons_per_pass as u64;
+        let photons =
+            trace_photons(&self.world, MapKind::Indirect, count, pass as u64, settings.seed, settings.max_depth);
+        stats.photons_traced = count;
+        stats.photons_stored = photons.len() as u64;
+        let tree = PhotonKdTree::build(photons);
+        stats.trace_time = trace_start.elapsed();
+        if !context.is_current() {
+            return None;
+        }
+        let alpha = settings.photon.sppm_alpha;
+        let radii: Vec<(f64, usize)> = buffers
+            .par_iter_mut()
+            .map(|buffer| {
+                if !context.is_current() {
+                    return (0.0, 0);
+                }
+                let mut sum = 0.0;
+                for pixel in buffer.sppm.iter_mut() {
+                    pixel.gather(&tree, alpha);
+                    sum += pixel.radius as f64;
+                }
+                buffer.samples += 1;
+                context.send(RenderEvent::Tile(TileUpdate {
+                    generation: context.generation,
+                    rect: buffer.rect,
+                    pixels: buffer.mean(),
+                    preview: false,
+                }));
+                (sum, buffer.sppm.len())
+            })
+            .collect();
+        let (sum, count) = radii.iter().fold((0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        stats.mean_radius = (sum / count.max(1) as f64) as f32;
+        per_tile.push(Counters::default());
+        Some(per_tile)
     }
 
     /// One sample per block, copied over the block.
     fn preview_tile(&self, rect: TileRect) -> Vec<[f32; 3]> {
         let mut pixels = vec![[0.0; 3]; (rect.width * rect.height) as usize];
         let mut counters = Counters::default();
+        let mut scratch = self.scratch();
         for by in (0..rect.height).step_by(PREVIEW_BLOCK as usize) {
             for bx in (0..rect.width).step_by(PREVIEW_BLOCK as usize) {
                 let (w, h) = (PREVIEW_BLOCK.min(rect.width - bx), PREVIEW_BLOCK.min(rect.height - by));
-                let value = self
-                    .sample(rect.x + bx + w / 2, rect.y + by + h / 2, PREVIEW_SAMPLE, &mut counters)
-                    .unwrap_or(Rgb::ZERO);
+                let (x, y) = (rect.x + bx + w / 2, rect.y + by + h / 2);
+                let value = match self.method {
+                    // SPPM has no estimate before its first pass: show direct light
+                    Method::Sppm => {
+                        let (ray, mut sampler) = self.camera_ray(x, y, PREVIEW_SAMPLE);
+                        let direct =
+                            camera_pass(&self.world, &ray, self.settings.max_depth, &mut sampler, &mut counters).0;
+                        self.finite(direct, &mut counters)
+                    }
+                    _ => self.sample(x, y, PREVIEW_SAMPLE, &mut counters, &mut scratch),
+                }
+                .unwrap_or(Rgb::ZERO);
                 for y in by..by + h {
                     for x in bx..bx + w {
                         pixels[(y * rect.width + x) as usize] = value.to_array();

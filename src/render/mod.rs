@@ -14,7 +14,7 @@ pub mod tiles;
 pub mod whitted;
 pub mod world;
 
-pub use engine::{render_blocking, PassStats, RenderEvent, RenderJob, RenderSession, TileUpdate};
+pub use engine::{render_blocking, PassStats, PhotonPassStats, RenderEvent, RenderJob, RenderSession, TileUpdate};
 pub use image::LinearImage;
 pub use settings::{Algorithm, PhotonSettings, RenderSettings};
 
@@ -23,4 +23,5 @@ pub use settings::{Algorithm, PhotonSettings, RenderSettings};
 pub struct Counters {
     pub rays: u64,
     pub non_finite: u64,
+    pub queries: crate::photon::QueryStats,
 }

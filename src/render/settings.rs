@@ -85,7 +85,7 @@ impl Default for PhotonSettings {
         Self {
             global_photons: 200_000,
             caustic_photons: 200_000,
-            k_nearest: 64,
+            k_nearest: 50,
             max_radius: 0.0,
             final_gather: false,
             final_gather_rays: 32,

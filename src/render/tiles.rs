@@ -1,6 +1,8 @@
 //! The image cut into tiles, rendered centre first, each owning its own
 //! accumulation buffer so parallel passes need no locks.
 
+use crate::photon::sppm::SppmPixel;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TileRect {
     pub x: u32,
@@ -35,16 +37,28 @@ pub fn tile_layout(width: u32, height: u32, tile_size: u32) -> Vec<TileRect> {
 pub struct TileAccumulator {
     pub rect: TileRect,
     pub sums: Vec<[f64; 3]>,
-    /// Samples added to every pixel of the tile.
+    /// Samples (passes) added to every pixel of the tile.
     pub samples: u32,
+    /// Progressive photon mapping's per-pixel state (empty otherwise).
+    pub sppm: Vec<SppmPixel>,
 }
 
 impl TileAccumulator {
-    pub fn new(rect: TileRect) -> Self {
-        Self { rect, sums: vec![[0.0; 3]; (rect.width * rect.height) as usize], samples: 0 }
+    pub fn new(rect: TileRect, sppm: bool) -> Self {
+        let pixels = (rect.width * rect.height) as usize;
+        Self {
+            rect,
+            sums: if sppm { Vec::new() } else { vec![[0.0; 3]; pixels] },
+            samples: 0,
+            sppm: if sppm { vec![SppmPixel::default(); pixels] } else { Vec::new() },
+        }
     }
 
+    /// The tile's current estimate, row-major.
     pub fn mean(&self) -> Vec<[f32; 3]> {
+        if !self.sppm.is_empty() {
+            return self.sppm.iter().map(|p| p.value(self.samples).to_array()).collect();
+        }
         let scale = 1.0 / self.samples.max(1) as f64;
         self.sums.iter().map(|s| s.map(|c| (c * scale) as f32)).collect()
     }

@@ -1,0 +1,223 @@
+//! Rendering with photon maps (Jensen): camera rays follow mirrors and glass;
+//! at the first non-specular surface, direct light by shadow rays, caustics
+//! from the caustic map, indirect light from the global map — directly or
+//! through a final gather of one bounce.
+
+use glam::Vec3;
+
+use super::kdtree::Neighbours;
+use super::maps::{estimate, PhotonMaps, QueryStats};
+use crate::geometry::Ray;
+use crate::render::bsdf::{Bsdf, Transport};
+use crate::render::rng::Sampler;
+use crate::render::world::{Hit, World};
+use crate::render::{Counters, PhotonSettings};
+use crate::scene::Rgb;
+
+/// Specular bounces a gather ray may follow before it must find a surface.
+const GATHER_SPECULAR_DEPTH: u32 = 4;
+
+/// What one tile reuses between camera samples: no allocation per ray.
+pub struct PhotonScratch {
+    pub neighbours: Neighbours,
+    pub queries: QueryStats,
+}
+
+impl PhotonScratch {
+    pub fn new(k: usize) -> Self {
+        Self { neighbours: Neighbours::new(k), queries: QueryStats::default() }
+    }
+}
+
+pub struct PhotonRenderer<'a> {
+    pub world: &'a World,
+    pub maps: &'a PhotonMaps,
+    pub settings: &'a PhotonSettings,
+    pub max_depth: u32,
+}
+
+impl PhotonRenderer<'_> {
+    fn k(&self) -> usize {
+        (self.settings.k_nearest as usize).max(super::maps::MIN_PHOTONS)
+    }
+
+    pub fn radiance(
+        &self,
+        ray: &Ray,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        scratch: &mut PhotonScratch,
+    ) -> Rgb {
+        let world = self.world;
+        let mut ray = *ray;
+        let mut throughput = Rgb::ONE;
+        let mut radiance = Rgb::ZERO;
+        for _ in 0..self.max_depth {
+            counters.rays += 1;
+            let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+                radiance += throughput * world.background;
+                break;
+            };
+            let wo = -ray.direction;
+            // Only specular bounces lead here, so emission is not light-sampled
+            radiance += throughput * world.emitted(&hit, wo);
+            let bsdf = Bsdf::new(world.material_of(&hit));
+            if bsdf.is_specular() {
+                let Some(s) =
+                    bsdf.sample(wo, hit.surface.normal, sampler.next_f32(), sampler.next_2d(), Transport::Radiance)
+                else {
+                    break;
+                };
+                throughput *= s.weight;
+                ray = hit.surface.spawn_ray(s.wi);
+                continue;
+            }
+            radiance +=
+                throughput * self.shade(&hit, wo, &bsdf, self.settings.final_gather, sampler, counters, scratch);
+            break;
+        }
+        radiance
+    }
+
+    /// Outgoing radiance at a non-specular hit, emission excluded.
+    #[allow(clippy::too_many_arguments)]
+    fn shade(
+        &self,
+        hit: &Hit,
+        wo: Vec3,
+        bsdf: &Bsdf,
+        gather: bool,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        scratch: &mut PhotonScratch,
+    ) -> Rgb {
+        let world = self.world;
+        let n = hit.surface.normal;
+        let facing = if wo.dot(n) < 0.0 { -n } else { n };
+        let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
+        let mut radiance = direct_light(world, hit, wo, facing, bsdf, sampler, counters);
+        radiance +=
+            estimate(&self.maps.caustic, point, facing, wo, bsdf, k, r, &mut scratch.neighbours, &mut scratch.queries);
+        if gather {
+            let rays = self.settings.final_gather_rays.max(1);
+            let mut sum = Rgb::ZERO;
+            for _ in 0..rays {
+                let Some(s) = bsdf.sample(wo, n, sampler.next_f32(), sampler.next_2d(), Transport::Radiance) else {
+                    continue;
+                };
+                sum += s.weight * self.gathered(hit.surface.spawn_ray(s.wi), sampler, counters, scratch);
+            }
+            radiance += sum / rays as f32;
+        } else {
+            radiance += estimate(
+                &self.maps.global,
+                point,
+                facing,
+                wo,
+                bsdf,
+                k,
+                r,
+                &mut scratch.neighbours,
+                &mut scratch.queries,
+            );
+            // Photons come only from lights: the background reaches the
+            // surface through one BSDF-sampled ray
+            if world.background != Rgb::ZERO {
+                if let Some(s) = bsdf.sample(wo, n, sampler.next_f32(), sampler.next_2d(), Transport::Radiance) {
+                    counters.rays += 1;
+                    if world.intersect(&hit.surface.spawn_ray(s.wi), f32::INFINITY).is_none() {
+                        radiance += s.weight * world.background;
+                    }
+                }
+            }
+        }
+        radiance
+    }
+
+    /// Radiance arriving along a final-gather ray: the maps' full estimate at
+    /// the next non-specular surface. Emitters seen directly (or through
+    /// mirrors) are skipped: direct light and caustics already count them.
+    fn gathered(
+        &self,
+        mut ray: Ray,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        scratch: &mut PhotonScratch,
+    ) -> Rgb {
+        let world = self.world;
+        let mut throughput = Rgb::ONE;
+        for _ in 0..GATHER_SPECULAR_DEPTH {
+            counters.rays += 1;
+            let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+                return throughput * world.background;
+            };
+            let wo = -ray.direction;
+            let bsdf = Bsdf::new(world.material_of(&hit));
+            if !bsdf.is_specular() {
+                let n = hit.surface.normal;
+                let facing = if wo.dot(n) < 0.0 { -n } else { n };
+                let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
+                let mut radiance = direct_light(world, &hit, wo, facing, &bsdf, sampler, counters);
+                radiance += estimate(
+                    &self.maps.caustic,
+                    point,
+                    facing,
+                    wo,
+                    &bsdf,
+                    k,
+                    r,
+                    &mut scratch.neighbours,
+                    &mut scratch.queries,
+                );
+                radiance += estimate(
+                    &self.maps.global,
+                    point,
+                    facing,
+                    wo,
+                    &bsdf,
+                    k,
+                    r,
+                    &mut scratch.neighbours,
+                    &mut scratch.queries,
+                );
+                return throughput * radiance;
+            }
+            let Some(s) =
+                bsdf.sample(wo, hit.surface.normal, sampler.next_f32(), sampler.next_2d(), Transport::Radiance)
+            else {
+                return Rgb::ZERO;
+            };
+            throughput *= s.weight;
+            ray = hit.surface.spawn_ray(s.wi);
+        }
+        Rgb::ZERO
+    }
+}
+
+/// Direct light by shadow rays, one sample of every light (less noise than
+/// one light per sample, and photon mapping's cost is elsewhere).
+pub fn direct_light(
+    world: &World,
+    hit: &Hit,
+    wo: Vec3,
+    facing: Vec3,
+    bsdf: &Bsdf,
+    sampler: &mut Sampler,
+    counters: &mut Counters,
+) -> Rgb {
+    let mut radiance = Rgb::ZERO;
+    for light in &world.lights {
+        let Some(sample) = light.sample(world, &hit.surface, sampler.next_2d()) else {
+            continue;
+        };
+        let f = bsdf.eval(wo, sample.wi, facing);
+        if f == Rgb::ZERO {
+            continue;
+        }
+        counters.rays += 1;
+        if !world.occluded(&sample.shadow, sample.shadow_t_max) {
+            radiance += f * sample.value * sample.wi.dot(facing);
+        }
+    }
+    radiance
+}
