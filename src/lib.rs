@@ -3,6 +3,7 @@
 //! (cli | app).
 #![forbid(unsafe_code)]
 
+pub mod analysis;
 pub mod cli;
 pub mod geometry;
 pub mod photon;

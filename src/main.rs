@@ -1,15 +1,26 @@
 //! `gi-studio` with no arguments opens the studio; subcommands run headless.
 
+use std::process::ExitCode;
+
 use clap::Parser;
 use gi_studio::cli::{Cli, Command};
 
-fn main() -> anyhow::Result<()> {
+fn main() -> ExitCode {
     let cli = Cli::parse();
-    match &cli.command {
+    let result = match &cli.command {
         Some(Command::Render(args)) => gi_studio::cli::render::run(args),
+        Some(Command::Photons(args)) => gi_studio::cli::photons::run(args),
         None => {
             println!("The studio window arrives with issue #4; until then use `gi-studio render --help`.");
             Ok(())
+        }
+    };
+    // Errors are reported once, here, as a user reads them (no backtrace)
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
         }
     }
 }

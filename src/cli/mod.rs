@@ -1,6 +1,7 @@
 //! The headless side of the binary: `render` (and, as they land, `photons`,
 //! `reference`, `bench`). Errors become `anyhow` here, at the edge.
 
+pub mod photons;
 pub mod render;
 
 use std::path::PathBuf;
@@ -43,6 +44,8 @@ pub struct StudioArgs {
 pub enum Command {
     /// Render a scene file to PNG (tone-mapped) or EXR (linear).
     Render(render::RenderArgs),
+    /// Trace a scene's photon maps once and save them for `render --photon-map`.
+    Photons(photons::PhotonsArgs),
 }
 
 /// Flags shared by every command that renders.
@@ -75,4 +78,73 @@ pub struct RenderFlags {
     /// Limit every sample's channels to this value (off by default: it biases).
     #[arg(long, default_value_t = 0.0)]
     pub clamp: f32,
+    #[command(flatten)]
+    pub photon: PhotonFlags,
+}
+
+/// Photon mapping's knobs; defaults as in `PhotonSettings`.
+#[derive(Debug, Args, Clone)]
+pub struct PhotonFlags {
+    /// Photons emitted for the global map.
+    #[arg(long)]
+    pub global_photons: Option<u32>,
+    /// Photons emitted toward specular objects for the caustic map.
+    #[arg(long)]
+    pub caustic_photons: Option<u32>,
+    /// Photons gathered per estimate (at least 8).
+    #[arg(long = "k")]
+    pub k_nearest: Option<u32>,
+    /// Largest gather radius (scene units; 0 = from the scene's size).
+    #[arg(long)]
+    pub max_radius: Option<f32>,
+    /// Estimate indirect light by a final gather instead of reading the global map directly.
+    #[arg(long)]
+    pub final_gather: bool,
+    /// Rays per final gather.
+    #[arg(long)]
+    pub gather_rays: Option<u32>,
+    /// SPPM: photons per pass.
+    #[arg(long)]
+    pub sppm_photons: Option<u32>,
+    /// SPPM: initial gather radius (0 = from the scene's size).
+    #[arg(long)]
+    pub sppm_radius: Option<f32>,
+    /// SPPM: radius reduction α in (0, 1].
+    #[arg(long)]
+    pub sppm_alpha: Option<f32>,
+}
+
+impl PhotonFlags {
+    pub fn apply(&self, settings: &mut crate::render::PhotonSettings) -> anyhow::Result<()> {
+        let p = settings;
+        if let Some(v) = self.global_photons {
+            p.global_photons = v;
+        }
+        if let Some(v) = self.caustic_photons {
+            p.caustic_photons = v;
+        }
+        if let Some(v) = self.k_nearest {
+            p.k_nearest = v.max(8);
+        }
+        if let Some(v) = self.max_radius {
+            anyhow::ensure!(v >= 0.0 && v.is_finite(), "--max-radius must be a finite number ≥ 0");
+            p.max_radius = v;
+        }
+        p.final_gather |= self.final_gather;
+        if let Some(v) = self.gather_rays {
+            p.final_gather_rays = v.max(1);
+        }
+        if let Some(v) = self.sppm_photons {
+            p.sppm_photons_per_pass = v;
+        }
+        if let Some(v) = self.sppm_radius {
+            anyhow::ensure!(v >= 0.0 && v.is_finite(), "--sppm-radius must be a finite number ≥ 0");
+            p.sppm_initial_radius = v;
+        }
+        if let Some(v) = self.sppm_alpha {
+            anyhow::ensure!(v > 0.0 && v <= 1.0, "--sppm-alpha must be in (0, 1]");
+            p.sppm_alpha = v;
+        }
+        Ok(())
+    }
 }

@@ -9,7 +9,10 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::RenderFlags;
-use crate::render::{PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
+use crate::photon::file::{load_photon_maps, settings_key};
+use crate::photon::maps::MapStats;
+use crate::photon::PhotonMapStats;
+use crate::render::{Algorithm, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
 use crate::scene::{load_scene, Scene};
 
 #[derive(Debug, Args)]
@@ -19,13 +22,25 @@ pub struct RenderArgs {
     /// Output image: .png (tone-mapped sRGB) or .exr (linear float).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Reuse photon maps saved by `gi-studio photons` (photon mapping only).
+    #[arg(long)]
+    pub photon_map: Option<PathBuf>,
     #[command(flatten)]
     pub flags: RenderFlags,
 }
 
+/// What a finished render reports besides its image.
+pub struct RenderOutcome {
+    pub image: crate::render::LinearImage,
+    pub stats: PassStats,
+    pub maps: Option<PhotonMapStats>,
+    /// SPPM's mean gather radius after each pass.
+    pub radii: Vec<f32>,
+}
+
 impl RenderFlags {
     /// Settings for `scene`, flags overriding the scene's own.
-    pub fn settings(&self, scene: &Scene) -> RenderSettings {
+    pub fn settings(&self, scene: &Scene) -> Result<RenderSettings> {
         let mut settings = RenderSettings::for_algorithm(self.algorithm);
         settings.width = self.width.unwrap_or(scene.settings.width);
         settings.height = self.height.unwrap_or(scene.settings.height);
@@ -39,8 +54,10 @@ impl RenderFlags {
         if let Some(depth) = self.max_depth {
             settings.max_depth = depth;
         }
+        anyhow::ensure!(self.clamp >= 0.0, "--clamp must not be negative");
         settings.firefly_clamp = self.clamp;
-        settings
+        self.photon.apply(&mut settings.photon)?;
+        Ok(settings)
     }
 }
 
@@ -50,16 +67,71 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !matches!(extension.as_deref(), Some("png" | "exr")) {
         bail!("{}: the output must end in .png or .exr", args.output.display());
     }
-    let settings = args.flags.settings(&scene);
+    let settings = args.flags.settings(&scene)?;
     let exposure = args.flags.exposure.unwrap_or(scene.settings.exposure);
-    let (image, stats) = render_with_progress(scene, settings.clone())?;
-    image.save(&args.output, exposure)?;
-    println!("{}", summary_line(&settings, &stats, &args.output.display().to_string()));
+    let mut job = RenderJob::new(Arc::new(scene), settings.clone());
+    if let Some(path) = &args.photon_map {
+        if settings.algorithm != Algorithm::Photon {
+            bail!("--photon-map is for --algo photon");
+        }
+        let keys = (job.scene.content_key(), settings_key(&settings.photon, settings.seed, settings.max_depth));
+        job.photon_maps = Some(Arc::new(load_photon_maps(path, keys.0, keys.1)?));
+    }
+    let outcome = render_with_progress(job)?;
+    outcome.image.save(&args.output, exposure)?;
+    println!("{}", summary_line(&settings, &outcome.stats, &args.output.display().to_string()));
+    print_photon_statistics(&outcome);
     Ok(())
 }
 
+pub fn print_photon_statistics(outcome: &RenderOutcome) {
+    if let Some(maps) = &outcome.maps {
+        for (name, map) in [("global", &maps.global), ("caustic", &maps.caustic)] {
+            println!("{}", map_line(name, map));
+        }
+    }
+    let q = &outcome.stats.photon.queries;
+    if q.queries > 0 {
+        let total: u64 = q.radius_histogram.iter().sum();
+        let histogram: Vec<String> =
+            q.radius_histogram.iter().map(|n| format!("{:.0}", 100.0 * *n as f64 / total.max(1) as f64)).collect();
+        println!(
+            "k-NN (last pass): {} queries, {:.1} nodes visited and {:.2} µs per query; gather radius / max radius, % per sixteenth: [{}]",
+            q.queries,
+            q.mean_nodes_visited(),
+            q.mean_query_time().as_secs_f64() * 1e6,
+            histogram.join(" ")
+        );
+    }
+    if !outcome.radii.is_empty() {
+        let first = outcome.radii[0];
+        let last = outcome.radii[outcome.radii.len() - 1];
+        let photon = &outcome.stats.photon;
+        println!(
+            "SPPM: mean radius {first:.4} after pass 1 → {last:.4} after pass {}; last pass traced {} photons ({} stored) in {:.0} ms",
+            outcome.radii.len(),
+            photon.photons_traced,
+            photon.photons_stored,
+            photon.trace_time.as_secs_f64() * 1e3
+        );
+    }
+}
+
+pub fn map_line(name: &str, map: &MapStats) -> String {
+    format!(
+        "{name} map: {} emitted, {} stored ({:.1} MB), traced in {:.0} ms, built in {:.0} ms, tree depth {}",
+        map.emitted,
+        map.stored,
+        map.bytes as f64 / 1e6,
+        map.trace_time.as_secs_f64() * 1e3,
+        map.build_time.as_secs_f64() * 1e3,
+        map.depth
+    )
+}
+
 /// Render on a session, showing passes (or seconds) on a progress bar.
-pub fn render_with_progress(scene: Scene, settings: RenderSettings) -> Result<(crate::render::LinearImage, PassStats)> {
+pub fn render_with_progress(job: RenderJob) -> Result<RenderOutcome> {
+    let settings = job.settings.clone();
     let bar = match (settings.samples_per_pixel, settings.time_limit) {
         (_, Some(seconds)) => ProgressBar::new((seconds * 10.0).ceil() as u64),
         (Some(spp), None) => ProgressBar::new(spp as u64),
@@ -72,7 +144,9 @@ pub fn render_with_progress(scene: Scene, settings: RenderSettings) -> Result<(c
     bar.enable_steady_tick(Duration::from_millis(200));
     let timed = settings.time_limit.is_some();
     let session = RenderSession::new(None);
-    let generation = session.start(RenderJob::new(Arc::new(scene), settings));
+    let generation = session.start(job);
+    let mut maps = None;
+    let mut radii = Vec::new();
     let result = loop {
         let Ok(event) = session.events().recv() else {
             bail!("the render worker stopped unexpectedly");
@@ -81,15 +155,23 @@ pub fn render_with_progress(scene: Scene, settings: RenderSettings) -> Result<(c
             continue;
         }
         match event {
+            RenderEvent::PhotonMaps { stats, .. } => {
+                maps = Some(stats);
+                bar.set_message("photon maps built");
+            }
             RenderEvent::PassFinished { stats, .. } => {
+                if settings.algorithm == Algorithm::Sppm {
+                    radii.push(stats.photon.mean_radius);
+                }
                 bar.set_position(if timed { (stats.elapsed.as_secs_f64() * 10.0) as u64 } else { stats.passes as u64 });
                 bar.set_message(format!("{} spp, {:.2} M samples/s", stats.passes, stats.samples_per_second() / 1e6));
             }
             RenderEvent::Finished { image, stats, .. } => {
-                break (Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone()), stats)
+                let image = Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone());
+                break RenderOutcome { image, stats, maps, radii };
             }
             RenderEvent::Failed { message, .. } => bail!("{message}"),
-            RenderEvent::Started { .. } | RenderEvent::Tile(_) | RenderEvent::PhotonMaps { .. } => {}
+            RenderEvent::Started { .. } | RenderEvent::Tile(_) => {}
         }
     };
     bar.finish_and_clear();

@@ -3,6 +3,7 @@
 //! estimates from them, and stochastic progressive photon mapping.
 
 pub mod emit;
+pub mod file;
 pub mod integrator;
 pub mod kdtree;
 pub mod maps;

@@ -22,6 +22,9 @@ pub enum MapKind {
     Caustic,
     /// SPPM: every non-specular hit but the first (direct light is sampled).
     Indirect,
+    /// Every non-specular hit, direct ones included (for inspecting the
+    /// photon distribution itself).
+    All,
 }
 
 const CHUNK: u64 = 4096;
@@ -82,6 +85,7 @@ fn trace_one(
                 MapKind::Global => diffuse_bounces > 0,
                 MapKind::Caustic => depth > 0,
                 MapKind::Indirect => depth > 0,
+                MapKind::All => true,
             };
             if keep && power.is_finite() {
                 stored.push(Photon::new(hit.surface.point, ray.direction, power.to_array()));

@@ -69,6 +69,18 @@ impl CameraModel {
         Ray::new(origin, direction)
     }
 
+    /// Film position (pixels) where a world point appears, if in front.
+    pub fn project(&self, point: Vec3) -> Option<Vec2> {
+        let v = point - self.position;
+        let depth = v.dot(self.forward);
+        if depth <= 0.0 {
+            return None;
+        }
+        let sx = v.dot(self.right) / depth / self.half_width;
+        let sy = v.dot(self.up) / depth / self.half_height;
+        Some(Vec2::new((sx + 1.0) * 0.5 * self.width, (1.0 - sy) * 0.5 * self.height))
+    }
+
     /// The ray through the centre of pixel (x, y), for picking.
     pub fn pixel_ray(&self, x: f32, y: f32) -> Ray {
         let saved = Self { aperture_radius: 0.0, ..self.clone() };
@@ -105,6 +117,10 @@ mod tests {
         assert!((left.direction.x / left.direction.z - 2.0).abs() < 1e-5);
         // Near clip measured along the view axis, not along the ray
         assert!((top.origin.z - 3.0).abs() < 1e-5);
+        // Projection inverts ray generation
+        let film = model.project(left.at(7.0)).unwrap();
+        assert!((film - Vec2::new(0.0, 50.0)).length() < 1e-3, "{film}");
+        assert!(model.project(Vec3::new(0.0, 0.0, 9.0)).is_none());
     }
 
     #[test]

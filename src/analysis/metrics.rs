@@ -1,0 +1,269 @@
+//! Error metrics between a rendered image and a reference: RMSE, relMSE
+//! (with optional outlier rejection), SSIM on tone-mapped luminance, and
+//! per-pixel relative error in false colour.
+
+use crate::render::image::{srgb_encode, LinearImage};
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MetricError {
+    #[error("image sizes differ: {test_width}×{test_height} against a {reference_width}×{reference_height} reference")]
+    SizeMismatch { test_width: u32, test_height: u32, reference_width: u32, reference_height: u32 },
+    #[error("the images are empty")]
+    Empty,
+}
+
+fn check(test: &LinearImage, reference: &LinearImage) -> Result<(), MetricError> {
+    if (test.width, test.height) != (reference.width, reference.height) {
+        return Err(MetricError::SizeMismatch {
+            test_width: test.width,
+            test_height: test.height,
+            reference_width: reference.width,
+            reference_height: reference.height,
+        });
+    }
+    if test.pixels.is_empty() {
+        return Err(MetricError::Empty);
+    }
+    Ok(())
+}
+
+/// Root-mean-square error over all pixels and channels.
+pub fn rmse(test: &LinearImage, reference: &LinearImage) -> Result<f64, MetricError> {
+    check(test, reference)?;
+    let sum: f64 = test
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .flat_map(|(t, r)| (0..3).map(move |c| (t[c] as f64 - r[c] as f64).powi(2)))
+        .sum();
+    Ok((sum / (3 * test.pixels.len()) as f64).sqrt())
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RelMseOptions {
+    /// Keeps dark reference pixels from dominating: (x − r)²/(r² + ε).
+    pub epsilon: f64,
+    /// Drop this fraction of the largest per-pixel errors (e.g. 1e-4: the top
+    /// 0.01%), so a few fireflies do not hide the trend.
+    pub reject_top_fraction: f64,
+}
+
+impl Default for RelMseOptions {
+    fn default() -> Self {
+        Self { epsilon: 1e-2, reject_top_fraction: 0.0 }
+    }
+}
+
+/// Per-pixel relative squared error, averaged over channels.
+pub fn per_pixel_rel_error(test: &LinearImage, reference: &LinearImage, epsilon: f64) -> Result<Vec<f64>, MetricError> {
+    check(test, reference)?;
+    Ok(test
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(t, r)| {
+            (0..3).map(|c| (t[c] as f64 - r[c] as f64).powi(2) / ((r[c] as f64).powi(2) + epsilon)).sum::<f64>() / 3.0
+        })
+        .collect())
+}
+
+/// Mean relative squared error, the standard measure for Monte Carlo
+/// convergence (it halves when the sample count doubles).
+pub fn rel_mse(test: &LinearImage, reference: &LinearImage, options: RelMseOptions) -> Result<f64, MetricError> {
+    let mut errors = per_pixel_rel_error(test, reference, options.epsilon)?;
+    let reject = ((errors.len() as f64) * options.reject_top_fraction).floor() as usize;
+    let keep = errors.len() - reject.min(errors.len() - 1);
+    if keep < errors.len() {
+        // Partition so the `keep` smallest come first; no full sort
+        errors.select_nth_unstable_by(keep - 1, f64::total_cmp);
+        errors.truncate(keep);
+    }
+    Ok(errors.iter().sum::<f64>() / errors.len() as f64)
+}
+
+/// Display luminance in [0, 1]: exposure, clamp, sRGB, Rec. 709 weights.
+fn display_luminance(image: &LinearImage, exposure: f32) -> Vec<f64> {
+    let scale = exposure.exp2();
+    image
+        .pixels
+        .iter()
+        .map(|p| {
+            let encoded = p.map(|c| {
+                let v = c * scale;
+                if v.is_finite() {
+                    srgb_encode(v.clamp(0.0, 1.0)) as f64
+                } else {
+                    0.0
+                }
+            });
+            0.2126 * encoded[0] + 0.7152 * encoded[1] + 0.0722 * encoded[2]
+        })
+        .collect()
+}
+
+/// Mean SSIM (Wang et al. 2004) of the tone-mapped luminance, Gaussian
+/// window 11×11 with σ = 1.5, clipped at the borders (weights renormalised).
+pub fn ssim(test: &LinearImage, reference: &LinearImage, exposure: f32) -> Result<f64, MetricError> {
+    check(test, reference)?;
+    const C1: f64 = 0.01 * 0.01;
+    const C2: f64 = 0.03 * 0.03;
+    let (w, h) = (test.width as i64, test.height as i64);
+    let (x, y) = (display_luminance(test, exposure), display_luminance(reference, exposure));
+    let kernel: Vec<f64> = (-5..=5).map(|i: i64| (-(i * i) as f64 / (2.0 * 1.5 * 1.5)).exp()).collect();
+    let mut total = 0.0;
+    for py in 0..h {
+        for px in 0..w {
+            let (mut sw, mut mx, mut my, mut xx, mut yy, mut xy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+            for dy in -5..=5i64 {
+                let qy = py + dy;
+                if qy < 0 || qy >= h {
+                    continue;
+                }
+                for dx in -5..=5i64 {
+                    let qx = px + dx;
+                    if qx < 0 || qx >= w {
+                        continue;
+                    }
+                    let k = kernel[(dy + 5) as usize] * kernel[(dx + 5) as usize];
+                    let i = (qy * w + qx) as usize;
+                    sw += k;
+                    mx += k * x[i];
+                    my += k * y[i];
+                    xx += k * x[i] * x[i];
+                    yy += k * y[i] * y[i];
+                    xy += k * x[i] * y[i];
+                }
+            }
+            let (mx, my) = (mx / sw, my / sw);
+            let vx = (xx / sw - mx * mx).max(0.0);
+            let vy = (yy / sw - my * my).max(0.0);
+            let cov = xy / sw - mx * my;
+            total += ((2.0 * mx * my + C1) * (2.0 * cov + C2)) / ((mx * mx + my * my + C1) * (vx + vy + C2));
+        }
+    }
+    Ok(total / (w * h) as f64)
+}
+
+/// Magma-like control points, dark (no error) to bright (large error).
+const MAGMA: [[u8; 3]; 9] = [
+    [0, 0, 4],
+    [28, 16, 68],
+    [79, 18, 123],
+    [129, 37, 129],
+    [181, 54, 122],
+    [229, 80, 100],
+    [251, 135, 97],
+    [254, 194, 135],
+    [252, 253, 191],
+];
+/// Non-finite values stand out in a colour the map never uses.
+pub const FLAG_COLOUR: [u8; 4] = [0, 255, 0, 255];
+
+/// Map values in [0, max] to RGBA along a perceptual colour map.
+pub fn false_colour(values: &[f64], max: f64) -> Vec<[u8; 4]> {
+    values
+        .iter()
+        .map(|v| {
+            if !v.is_finite() {
+                return FLAG_COLOUR;
+            }
+            let t = if max > 0.0 { (v / max).clamp(0.0, 1.0) } else { 0.0 } * (MAGMA.len() - 1) as f64;
+            let i = (t.floor() as usize).min(MAGMA.len() - 2);
+            let f = t - i as f64;
+            let (a, b) = (MAGMA[i], MAGMA[i + 1]);
+            let mix = |c: usize| (a[c] as f64 + (b[c] as f64 - a[c] as f64) * f).round() as u8;
+            [mix(0), mix(1), mix(2), 255]
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::rng::Sampler;
+
+    fn image(w: u32, h: u32, f: impl Fn(u32, u32) -> [f32; 3]) -> LinearImage {
+        LinearImage {
+            width: w,
+            height: h,
+            pixels: (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| f(x, y)).collect(),
+        }
+    }
+
+    fn gradient() -> LinearImage {
+        image(32, 24, |x, y| [x as f32 / 32.0, y as f32 / 24.0, 0.5])
+    }
+
+    fn noisy(base: &LinearImage, amplitude: f32, seed: u64) -> LinearImage {
+        let mut s = Sampler::new(0, 0, seed);
+        let mut out = base.clone();
+        for p in &mut out.pixels {
+            for c in p.iter_mut() {
+                *c = (*c + (s.next_f32() - 0.5) * amplitude).max(0.0);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn rmse_of_identical_is_zero_and_of_an_offset_is_the_offset() {
+        let a = gradient();
+        assert_eq!(rmse(&a, &a).unwrap(), 0.0);
+        let mut b = a.clone();
+        b.pixels.iter_mut().for_each(|p| p.iter_mut().for_each(|c| *c += 0.25));
+        assert!((rmse(&b, &a).unwrap() - 0.25).abs() < 1e-6);
+    }
+
+    #[test]
+    fn rel_mse_by_hand_and_rejection_removes_the_outlier() {
+        let reference = image(2, 1, |_, _| [1.0; 3]);
+        let test = image(2, 1, |x, _| if x == 0 { [2.0; 3] } else { [1.0; 3] });
+        // Pixel 0: (2−1)²/(1 + 0.01) per channel; pixel 1: 0
+        let expected = (1.0 / 1.01) / 2.0;
+        assert!((rel_mse(&test, &reference, RelMseOptions::default()).unwrap() - expected).abs() < 1e-12);
+
+        let reference = image(100, 100, |_, _| [0.5; 3]);
+        let clean = image(100, 100, |x, _| [0.5 + 0.01 * (x % 2) as f32; 3]);
+        let mut spiked = clean.clone();
+        spiked.pixels[1234] = [1e6; 3];
+        let options = RelMseOptions { reject_top_fraction: 1e-4, ..Default::default() };
+        let clean_error = rel_mse(&clean, &reference, RelMseOptions::default()).unwrap();
+        let spiked_error = rel_mse(&spiked, &reference, options).unwrap();
+        // Rejection drops the spike; the mean is then over one pixel fewer
+        assert!(
+            (spiked_error - clean_error * 10_000.0 / 9_999.0).abs() < 1e-9 * clean_error.max(1.0) + 1e-6 * clean_error
+        );
+        assert!(rel_mse(&spiked, &reference, RelMseOptions::default()).unwrap() > 1e3);
+    }
+
+    #[test]
+    fn sizes_must_match() {
+        let a = gradient();
+        let b = image(3, 3, |_, _| [0.0; 3]);
+        assert!(matches!(rmse(&a, &b), Err(MetricError::SizeMismatch { .. })));
+        assert!(matches!(ssim(&a, &b, 0.0), Err(MetricError::SizeMismatch { .. })));
+    }
+
+    #[test]
+    fn ssim_is_one_for_identical_symmetric_and_falls_with_noise() {
+        let a = gradient();
+        assert!((ssim(&a, &a, 0.0).unwrap() - 1.0).abs() < 1e-12);
+        let b = noisy(&a, 0.1, 1);
+        assert!((ssim(&a, &b, 0.0).unwrap() - ssim(&b, &a, 0.0).unwrap()).abs() < 1e-12);
+        let mut last = 1.0;
+        for amplitude in [0.02, 0.1, 0.3, 0.8] {
+            let s = ssim(&noisy(&a, amplitude, 2), &a, 0.0).unwrap();
+            assert!(s < last, "amplitude {amplitude}: {s} ≥ {last}");
+            last = s;
+        }
+    }
+
+    #[test]
+    fn false_colour_ends_and_flag() {
+        let colours = false_colour(&[0.0, 1.0, 2.0, f64::NAN], 1.0);
+        assert_eq!(colours[0], [0, 0, 4, 255]);
+        assert_eq!(colours[1], [252, 253, 191, 255]);
+        assert_eq!(colours[2], colours[1]);
+        assert_eq!(colours[3], FLAG_COLOUR);
+    }
+}

@@ -1,0 +1,43 @@
+//! `gi-studio photons`: trace a scene's photon maps once and save them.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::Result;
+use clap::Args;
+use indicatif::ProgressBar;
+
+use super::render::map_line;
+use super::RenderFlags;
+use crate::photon::file::{save_photon_maps, settings_key};
+use crate::photon::PhotonMaps;
+use crate::render::world::World;
+use crate::scene::load_scene;
+
+#[derive(Debug, Args)]
+pub struct PhotonsArgs {
+    /// Scene file (RON).
+    pub scene: PathBuf,
+    /// Where to write the maps (e.g. caustics.pmap).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub flags: RenderFlags,
+}
+
+pub fn run(args: &PhotonsArgs) -> Result<()> {
+    let scene = load_scene(&args.scene)?;
+    let settings = args.flags.settings(&scene)?;
+    let bar = ProgressBar::new_spinner().with_message("tracing photons");
+    bar.enable_steady_tick(Duration::from_millis(120));
+    let world = World::new(&scene);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build()?;
+    let maps = pool.install(|| PhotonMaps::build(&world, &settings.photon, settings.seed, settings.max_depth));
+    bar.finish_and_clear();
+    let key = settings_key(&settings.photon, settings.seed, settings.max_depth);
+    save_photon_maps(&maps, scene.content_key(), key, &args.output)?;
+    println!("{}", map_line("global", &maps.stats.global));
+    println!("{}", map_line("caustic", &maps.stats.caustic));
+    println!("→ {}", args.output.display());
+    Ok(())
+}

@@ -1,0 +1,177 @@
+//! Photon mapping and SPPM: stored power against the analytic fraction,
+//! agreement with converged path tracing, SPPM's falling error, the caustic,
+//! and photon maps saved and loaded.
+
+mod common;
+
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+use common::*;
+use gi_studio::analysis::metrics::{rel_mse, RelMseOptions};
+use gi_studio::photon::file::{load_photon_maps, save_photon_maps, settings_key, PhotonFileError};
+use gi_studio::photon::trace::{trace_photons, MapKind};
+use gi_studio::photon::PhotonMaps;
+use gi_studio::render::camera::CameraModel;
+use gi_studio::render::world::World;
+use gi_studio::render::{
+    render_blocking, Algorithm, LinearImage, RenderEvent, RenderJob, RenderSession, RenderSettings,
+};
+use gi_studio::scene::{presets, LightKind, MaterialModel, Scene};
+use glam::Vec3;
+
+fn settings(algorithm: Algorithm, width: u32, height: u32, spp: u32) -> RenderSettings {
+    RenderSettings { width, height, samples_per_pixel: Some(spp), seed: 5, ..RenderSettings::for_algorithm(algorithm) }
+}
+
+fn render(scene: &Scene, settings: RenderSettings) -> LinearImage {
+    render_blocking(&RenderJob::new(Arc::new(scene.clone()), settings)).expect("renders").0
+}
+
+/// A Cornell box with the mirror and glass balls made diffuse.
+fn diffuse_cornell() -> Scene {
+    let mut scene = presets::preset("cornell").unwrap().unwrap();
+    for material in &mut scene.materials {
+        if matches!(material.model, MaterialModel::Mirror { .. } | MaterialModel::Glass { .. }) {
+            material.model = MaterialModel::Lambert { albedo: Vec3::splat(0.6) };
+        }
+    }
+    scene
+}
+
+#[test]
+fn photons_on_a_plane_carry_the_analytic_share_of_a_point_lights_power() {
+    let (height, intensity, radius) = (2.0f32, 3.0f32, 1.5f32);
+    let scene =
+        floor_scene(0.0, vec![light("bulb", LightKind::Point { position: Vec3::new(0.0, height, 0.0) }, intensity)]);
+    let world = World::new(&scene);
+    let photons = trace_photons(&world, MapKind::All, 400_000, 0, 1, 4);
+    let within: f64 = photons
+        .iter()
+        .filter(|p| Vec3::new(p.position.x, 0.0, p.position.z).length() <= radius)
+        .map(|p| p.power[0] as f64)
+        .sum();
+    // The disc subtends the cone of half-angle atan(R/h): power I·2π(1 − cos θ)
+    let cos = height / (height * height + radius * radius).sqrt();
+    let expected = intensity as f64 * 2.0 * PI as f64 * (1.0 - cos) as f64;
+    assert!((within - expected).abs() < 0.01 * expected, "{within} vs {expected}");
+    // Everything that goes down lands on the infinite plane: half the power
+    let total: f64 = photons.iter().map(|p| p.power[1] as f64).sum();
+    let half = 2.0 * PI as f64 * intensity as f64;
+    assert!((total - half).abs() < 0.01 * half, "{total} vs {half}");
+}
+
+#[test]
+fn photon_mapping_agrees_with_converged_path_tracing_on_a_diffuse_scene() {
+    let scene = diffuse_cornell();
+    let reference = render(&scene, settings(Algorithm::Path, 40, 30, 2048));
+    let mut photon = settings(Algorithm::Photon, 40, 30, 64);
+    photon.photon.global_photons = 1_000_000;
+    photon.photon.k_nearest = 100;
+    let image = render(&scene, photon);
+    let error = rel_mse(&image, &reference, RelMseOptions::default()).unwrap();
+    assert!(error < 0.02, "relMSE {error}");
+}
+
+#[test]
+fn sppm_error_keeps_falling() {
+    let scene = presets::preset("caustics").unwrap().unwrap();
+    let reference = render(&scene, settings(Algorithm::Path, 40, 30, 4096));
+    let mut sppm = settings(Algorithm::Sppm, 40, 30, 64);
+    sppm.photon.sppm_photons_per_pass = 20_000;
+    let session = RenderSession::new(None);
+    let generation = session.start(RenderJob::new(Arc::new(scene), sppm));
+    let mut errors = Vec::new();
+    let mut current = LinearImage::new(40, 30);
+    for event in session.events().iter() {
+        match event {
+            RenderEvent::Tile(tile) if tile.generation == generation => {
+                for (i, p) in tile.pixels.iter().enumerate() {
+                    let (x, y) = (tile.rect.x + i as u32 % tile.rect.width, tile.rect.y + i as u32 / tile.rect.width);
+                    current.pixels[(y * 40 + x) as usize] = *p;
+                }
+            }
+            RenderEvent::PassFinished { stats, .. } if stats.passes == 8 || stats.passes == 64 => {
+                errors.push(rel_mse(&current, &reference, RelMseOptions::default()).unwrap());
+                assert!(stats.photon.mean_radius > 0.0 && stats.photon.mean_radius.is_finite());
+            }
+            RenderEvent::Finished { .. } => break,
+            _ => {}
+        }
+    }
+    assert_eq!(errors.len(), 2);
+    assert!(errors[1] < errors[0], "relMSE after 8 passes {} vs after 64 {}", errors[0], errors[1]);
+}
+
+#[test]
+fn the_caustic_under_the_glass_ball_is_brighter_than_its_surroundings() {
+    let scene = presets::preset("caustics").unwrap().unwrap();
+    let (w, h) = (96, 72);
+    let camera = CameraModel::new(&scene.camera, w, h);
+    // Light through the ball's centre reaches the floor here (a ball lens
+    // focuses just beyond): the caustic. Beside it, plain lit floor.
+    let light = Vec3::new(-1.3, 2.2, 0.0);
+    let through = (Vec3::new(0.0, 0.5, 0.0) - light).normalize();
+    let caustic = Vec3::new(0.0, 0.5, 0.0) + through * (0.5 / -through.y);
+    let beside = caustic + Vec3::new(0.0, 0.0, 0.9);
+    let mean_around = |image: &LinearImage, point: Vec3| {
+        let p = camera.project(point).unwrap();
+        let mut sum = 0.0;
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let q = image.get((p.x as i32 + dx) as u32, (p.y as i32 + dy) as u32);
+                sum += (q[0] + q[1] + q[2]) as f64 / 3.0;
+            }
+        }
+        sum / 9.0
+    };
+    let path = render(&scene, settings(Algorithm::Path, w, h, 1024));
+    let photon = render(&scene, settings(Algorithm::Photon, w, h, 16));
+    for (name, image) in [("path", &path), ("photon", &photon)] {
+        let (bright, plain) = (mean_around(image, caustic), mean_around(image, beside));
+        assert!(bright > 1.5 * plain, "{name}: caustic {bright} vs floor {plain}");
+    }
+}
+
+#[test]
+fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
+    let scene = presets::preset("caustics").unwrap().unwrap();
+    let mut s = settings(Algorithm::Photon, 32, 24, 2);
+    s.photon.global_photons = 20_000;
+    s.photon.caustic_photons = 20_000;
+    let world = World::new(&scene);
+    let maps = PhotonMaps::build(&world, &s.photon, s.seed, s.max_depth);
+    let dir = std::env::temp_dir().join(format!("gi-pmap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("caustics.pmap");
+    let (scene_key, key) = (scene.content_key(), settings_key(&s.photon, s.seed, s.max_depth));
+    save_photon_maps(&maps, scene_key, key, &path).unwrap();
+
+    let fresh = render(&scene, s.clone());
+    let mut job = RenderJob::new(Arc::new(scene.clone()), s.clone());
+    job.photon_maps = Some(Arc::new(load_photon_maps(&path, scene_key, key).unwrap()));
+    assert_eq!(render_blocking(&job).unwrap().0, fresh);
+
+    let mut other_scene = scene.clone();
+    other_scene.objects[2].name = "renamed ball".into();
+    assert!(matches!(load_photon_maps(&path, other_scene.content_key(), key), Err(PhotonFileError::OtherScene { .. })));
+    let mut other = s.photon.clone();
+    other.global_photons += 1;
+    assert!(matches!(
+        load_photon_maps(&path, scene_key, settings_key(&other, s.seed, s.max_depth)),
+        Err(PhotonFileError::OtherSettings { .. })
+    ));
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[8] = 99;
+    std::fs::write(dir.join("v99.pmap"), &bytes).unwrap();
+    let error = load_photon_maps(&dir.join("v99.pmap"), scene_key, key).unwrap_err();
+    assert!(matches!(error, PhotonFileError::Version { found: 99, .. }), "{error}");
+    assert!(error.to_string().contains("version 99"));
+    std::fs::write(dir.join("junk.pmap"), b"not a map").unwrap();
+    assert!(matches!(
+        load_photon_maps(&dir.join("junk.pmap"), scene_key, key),
+        Err(PhotonFileError::NotAPhotonMap { .. })
+    ));
+    std::fs::write(dir.join("short.pmap"), &std::fs::read(&path).unwrap()[..100]).unwrap();
+    assert!(matches!(load_photon_maps(&dir.join("short.pmap"), scene_key, key), Err(PhotonFileError::Damaged { .. })));
+}
