@@ -10,10 +10,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Some(Command::Render(args)) => gi_studio::cli::render::run(args),
         Some(Command::Photons(args)) => gi_studio::cli::photons::run(args),
-        None => {
-            println!("The studio window arrives with issue #4; until then use `gi-studio render --help`.");
-            Ok(())
-        }
+        None => gi_studio::app::run(cli.studio.clone()),
     };
     // Errors are reported once, here, as a user reads them (no backtrace)
     match result {

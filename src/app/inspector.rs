@@ -1,0 +1,370 @@
+//! The scene inspector: lists of objects, materials and lights, and the
+//! selected item's properties as drag values, colour pickers and combo
+//! boxes. It edits the scene in place; the studio validates every change
+//! before any of it reaches the engine.
+
+use eframe::egui;
+use glam::Vec3;
+
+use crate::scene::{Attenuation, Invalid, Light, LightKind, Material, MaterialModel, Object, Scene, Shape};
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Selection {
+    #[default]
+    Camera,
+    Object(usize),
+    Material(usize),
+    Light(usize),
+}
+
+pub fn inspector_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection, problems: &[Invalid]) {
+    if !problems.is_empty() {
+        egui::Frame::new().fill(ui.visuals().extreme_bg_color).inner_margin(6.0).show(ui, |ui| {
+            ui.colored_label(ui.visuals().error_fg_color, "Not rendered until fixed:");
+            for problem in problems {
+                ui.colored_label(ui.visuals().error_fg_color, problem.to_string());
+            }
+        });
+    }
+    egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
+        ui.selectable_value(selection, Selection::Camera, "Camera");
+        list_ui(ui, "Objects", scene, selection);
+        ui.separator();
+        ui.heading(selected_title(scene, *selection));
+        properties_ui(ui, scene, selection);
+    });
+}
+
+fn selected_title(scene: &Scene, selection: Selection) -> String {
+    match selection {
+        Selection::Camera => "Camera".into(),
+        Selection::Object(i) => scene.objects.get(i).map_or("—".into(), |o| format!("Object “{}”", o.name)),
+        Selection::Material(i) => scene.materials.get(i).map_or("—".into(), |m| format!("Material “{}”", m.name)),
+        Selection::Light(i) => scene.lights.get(i).map_or("—".into(), |l| format!("Light “{}”", l.name)),
+    }
+}
+
+fn unique_name(base: &str, taken: impl Fn(&str) -> bool) -> String {
+    (1..).map(|n| if n == 1 { base.to_owned() } else { format!("{base} {n}") }).find(|n| !taken(n)).unwrap_or_default()
+}
+
+fn list_ui(ui: &mut egui::Ui, _title: &str, scene: &mut Scene, selection: &mut Selection) {
+    egui::CollapsingHeader::new("Objects").default_open(true).show(ui, |ui| {
+        for (i, object) in scene.objects.iter().enumerate() {
+            ui.selectable_value(
+                selection,
+                Selection::Object(i),
+                format!("{} ({})", object.name, shape_name(&object.shape)),
+            );
+        }
+        ui.horizontal(|ui| {
+            ui.menu_button("Add", |ui| {
+                let material = scene.materials.first().map(|m| m.name.clone()).unwrap_or_default();
+                let shapes = [
+                    ("Sphere", Shape::Sphere { center: Vec3::new(0.0, 0.5, 0.0), radius: 0.5 }),
+                    ("Plane", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }),
+                    ("Triangle", Shape::Triangle { a: Vec3::ZERO, b: Vec3::X, c: Vec3::Y }),
+                ];
+                for (label, shape) in shapes {
+                    if ui.button(label).clicked() {
+                        let name = unique_name(&label.to_lowercase(), |n| scene.objects.iter().any(|o| o.name == n));
+                        scene.objects.push(Object { name, shape, material: material.clone() });
+                        *selection = Selection::Object(scene.objects.len() - 1);
+                        ui.close();
+                    }
+                }
+            });
+            if let Selection::Object(i) = *selection {
+                if i < scene.objects.len() {
+                    if ui.button("Duplicate").clicked() {
+                        let mut copy = scene.objects[i].clone();
+                        copy.name = unique_name(&copy.name, |n| scene.objects.iter().any(|o| o.name == n));
+                        scene.objects.insert(i + 1, copy);
+                        *selection = Selection::Object(i + 1);
+                    }
+                    if ui.button("Delete").clicked() {
+                        scene.objects.remove(i);
+                        *selection = Selection::Camera;
+                    }
+                }
+            }
+        });
+    });
+    egui::CollapsingHeader::new("Materials").default_open(true).show(ui, |ui| {
+        for (i, material) in scene.materials.iter().enumerate() {
+            ui.selectable_value(
+                selection,
+                Selection::Material(i),
+                format!("{} ({})", material.name, material.model.kind_name()),
+            );
+        }
+        ui.horizontal(|ui| {
+            if ui.button("Add").clicked() {
+                let name = unique_name("material", |n| scene.materials.iter().any(|m| m.name == n));
+                scene.materials.push(Material { name, model: MaterialModel::Lambert { albedo: Vec3::splat(0.7) } });
+                *selection = Selection::Material(scene.materials.len() - 1);
+            }
+            if let Selection::Material(i) = *selection {
+                if i < scene.materials.len() {
+                    if ui.button("Duplicate").clicked() {
+                        let mut copy = scene.materials[i].clone();
+                        copy.name = unique_name(&copy.name, |n| scene.materials.iter().any(|m| m.name == n));
+                        scene.materials.insert(i + 1, copy);
+                        *selection = Selection::Material(i + 1);
+                    }
+                    let used = scene.objects.iter().any(|o| o.material == scene.materials[i].name);
+                    let delete = ui.add_enabled(!used, egui::Button::new("Delete"));
+                    if delete.on_disabled_hover_text("Objects still use this material").clicked() {
+                        scene.materials.remove(i);
+                        *selection = Selection::Camera;
+                    }
+                }
+            }
+        });
+    });
+    egui::CollapsingHeader::new("Lights").default_open(true).show(ui, |ui| {
+        for (i, light) in scene.lights.iter_mut().enumerate() {
+            ui.horizontal(|ui| {
+                ui.checkbox(&mut light.enabled, "").on_hover_text("Enabled");
+                ui.selectable_value(
+                    selection,
+                    Selection::Light(i),
+                    format!("{} ({})", light.name, light.kind.kind_name()),
+                );
+            });
+        }
+        ui.horizontal(|ui| {
+            if ui.button("Add").clicked() {
+                let name = unique_name("light", |n| scene.lights.iter().any(|l| l.name == n));
+                scene.lights.push(Light {
+                    name,
+                    kind: LightKind::Point { position: Vec3::new(0.0, 3.0, 2.0) },
+                    color: Vec3::ONE,
+                    intensity: 10.0,
+                    attenuation: Attenuation::default(),
+                    enabled: true,
+                });
+                *selection = Selection::Light(scene.lights.len() - 1);
+            }
+            if let Selection::Light(i) = *selection {
+                if i < scene.lights.len() {
+                    if ui.button("Duplicate").clicked() {
+                        let mut copy = scene.lights[i].clone();
+                        copy.name = unique_name(&copy.name, |n| scene.lights.iter().any(|l| l.name == n));
+                        scene.lights.insert(i + 1, copy);
+                        *selection = Selection::Light(i + 1);
+                    }
+                    if ui.button("Delete").clicked() {
+                        scene.lights.remove(i);
+                        *selection = Selection::Camera;
+                    }
+                }
+            }
+        });
+    });
+}
+
+fn shape_name(shape: &Shape) -> &'static str {
+    match shape {
+        Shape::Sphere { .. } => "sphere",
+        Shape::Plane { .. } => "plane",
+        Shape::Triangle { .. } => "triangle",
+    }
+}
+
+fn vec3_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f64) {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        for (axis, c) in ["x", "y", "z"].into_iter().zip([&mut v.x, &mut v.y, &mut v.z]) {
+            ui.add(egui::DragValue::new(c).speed(speed).prefix(format!("{axis} ")));
+        }
+    });
+}
+
+fn scalar_ui(ui: &mut egui::Ui, label: &str, v: &mut f32, range: std::ops::RangeInclusive<f32>, speed: f64) {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        ui.add(egui::DragValue::new(v).speed(speed).range(range));
+    });
+}
+
+/// A reflectance in [0, 1]: a colour picker.
+fn reflectance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        let mut rgb = v.to_array();
+        if ui.color_edit_button_rgb(&mut rgb).changed() {
+            *v = Vec3::from_array(rgb).clamp(Vec3::ZERO, Vec3::ONE);
+        }
+        for c in [&mut v.x, &mut v.y, &mut v.z] {
+            ui.add(egui::DragValue::new(c).speed(0.005).range(0.0..=1.0));
+        }
+    });
+}
+
+/// Radiance or power: unbounded above, never negative.
+fn radiance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        for c in [&mut v.x, &mut v.y, &mut v.z] {
+            ui.add(egui::DragValue::new(c).speed(0.05).range(0.0..=f32::MAX));
+        }
+    });
+}
+
+fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection) {
+    match *selection {
+        Selection::Camera => {
+            let camera = &mut scene.camera;
+            vec3_ui(ui, "Position", &mut camera.position, 0.01);
+            vec3_ui(ui, "Look at", &mut camera.look_at, 0.01);
+            vec3_ui(ui, "Up", &mut camera.up, 0.01);
+            ui.add(egui::Slider::new(&mut camera.fov_y_degrees, 1.0..=170.0).text("Field of view °"));
+            scalar_ui(ui, "Near clip", &mut camera.near_clip, 0.0..=f32::MAX, 0.01);
+            scalar_ui(ui, "Aperture radius", &mut camera.aperture_radius, 0.0..=f32::MAX, 0.001);
+            scalar_ui(ui, "Focus distance (0: look-at)", &mut camera.focus_distance, 0.0..=f32::MAX, 0.01);
+            radiance_ui(ui, "Background", &mut scene.background);
+            radiance_ui(ui, "Ambient (Whitted)", &mut scene.ambient);
+        }
+        Selection::Object(i) => {
+            let names: Vec<String> = scene.materials.iter().map(|m| m.name.clone()).collect();
+            let Some(object) = scene.objects.get_mut(i) else { return };
+            ui.horizontal(|ui| {
+                ui.label("Name");
+                ui.text_edit_singleline(&mut object.name);
+            });
+            egui::ComboBox::from_label("Material").selected_text(object.material.clone()).show_ui(ui, |ui| {
+                for name in names {
+                    ui.selectable_value(&mut object.material, name.clone(), name);
+                }
+            });
+            match &mut object.shape {
+                Shape::Sphere { center, radius } => {
+                    vec3_ui(ui, "Centre", center, 0.01);
+                    ui.horizontal(|ui| {
+                        ui.label("Radius");
+                        ui.add(egui::DragValue::new(radius).speed(0.01).range(1e-6..=f32::MAX));
+                    });
+                }
+                Shape::Plane { point, normal } => {
+                    vec3_ui(ui, "Point", point, 0.01);
+                    vec3_ui(ui, "Normal", normal, 0.01);
+                }
+                Shape::Triangle { a, b, c } => {
+                    vec3_ui(ui, "A", a, 0.01);
+                    vec3_ui(ui, "B", b, 0.01);
+                    vec3_ui(ui, "C", c, 0.01);
+                }
+            }
+        }
+        Selection::Material(i) => {
+            let Some(material) = scene.materials.get_mut(i) else { return };
+            let old_name = material.name.clone();
+            ui.horizontal(|ui| {
+                ui.label("Name");
+                ui.text_edit_singleline(&mut material.name);
+            });
+            material_model_ui(ui, &mut material.model);
+            // Renaming a material keeps its objects pointing at it
+            let new_name = material.name.clone();
+            if new_name != old_name {
+                for object in scene.objects.iter_mut().filter(|o| o.material == old_name) {
+                    object.material = new_name.clone();
+                }
+            }
+        }
+        Selection::Light(i) => {
+            let Some(light) = scene.lights.get_mut(i) else { return };
+            ui.horizontal(|ui| {
+                ui.label("Name");
+                ui.text_edit_singleline(&mut light.name);
+            });
+            ui.checkbox(&mut light.enabled, "Enabled");
+            light_kind_ui(ui, &mut light.kind);
+            reflectance_ui(ui, "Colour", &mut light.color);
+            scalar_ui(ui, "Intensity", &mut light.intensity, 0.0..=f32::MAX, 0.1);
+            if !matches!(light.kind, LightKind::Directional { .. }) {
+                ui.label("Attenuation 1/(a·d² + b·d + c)");
+                ui.horizontal(|ui| {
+                    let a = &mut light.attenuation;
+                    for (label, v) in [("a", &mut a.a), ("b", &mut a.b), ("c", &mut a.c)] {
+                        ui.add(egui::DragValue::new(v).speed(0.01).range(0.0..=f32::MAX).prefix(format!("{label} ")));
+                    }
+                });
+            }
+        }
+    }
+}
+
+fn material_model_ui(ui: &mut egui::Ui, model: &mut MaterialModel) {
+    let (kd, ks) = match model {
+        MaterialModel::Lambert { albedo } => (*albedo, Vec3::ZERO),
+        MaterialModel::Phong { kd, ks, .. } | MaterialModel::BlinnPhong { kd, ks, .. } => (*kd, *ks),
+        MaterialModel::Mirror { tint } | MaterialModel::Glass { tint, .. } => (*tint * 0.5, *tint * 0.5),
+        MaterialModel::Emissive { radiance } => (radiance.min(Vec3::ONE), Vec3::ZERO),
+    };
+    let choices = [
+        MaterialModel::Lambert { albedo: kd },
+        MaterialModel::Phong { ka: kd, kd, ks: ks.max(Vec3::splat(0.2)).min(Vec3::ONE - kd), shininess: 30.0 },
+        MaterialModel::BlinnPhong { ka: kd, kd, ks: ks.max(Vec3::splat(0.2)).min(Vec3::ONE - kd), shininess: 60.0 },
+        MaterialModel::Mirror { tint: Vec3::splat(0.95) },
+        MaterialModel::Glass { ior: 1.5, tint: Vec3::ONE },
+        MaterialModel::Emissive { radiance: Vec3::splat(5.0) },
+    ];
+    egui::ComboBox::from_label("Model").selected_text(model.kind_name()).show_ui(ui, |ui| {
+        for choice in choices {
+            if ui.selectable_label(choice.kind_name() == model.kind_name(), choice.kind_name()).clicked()
+                && choice.kind_name() != model.kind_name()
+            {
+                *model = choice;
+            }
+        }
+    });
+    match model {
+        MaterialModel::Lambert { albedo } => reflectance_ui(ui, "Albedo", albedo),
+        MaterialModel::Phong { ka, kd, ks, shininess } | MaterialModel::BlinnPhong { ka, kd, ks, shininess } => {
+            reflectance_ui(ui, "ka", ka);
+            reflectance_ui(ui, "kd", kd);
+            reflectance_ui(ui, "ks", ks);
+            ui.add(egui::Slider::new(shininess, 0.0..=2000.0).logarithmic(true).text("Shininess"));
+        }
+        MaterialModel::Mirror { tint } => reflectance_ui(ui, "Tint", tint),
+        MaterialModel::Glass { ior, tint } => {
+            ui.add(egui::Slider::new(ior, 1.0..=3.0).text("Index of refraction"));
+            reflectance_ui(ui, "Tint", tint);
+        }
+        MaterialModel::Emissive { radiance } => radiance_ui(ui, "Radiance", radiance),
+    }
+}
+
+fn light_kind_ui(ui: &mut egui::Ui, kind: &mut LightKind) {
+    let (position, direction) = match kind {
+        LightKind::Point { position } => (*position, Vec3::NEG_Y),
+        LightKind::Directional { direction } => (Vec3::new(0.0, 3.0, 0.0), *direction),
+        LightKind::Spot { position, direction, .. } => (*position, *direction),
+    };
+    let choices = [
+        LightKind::Point { position },
+        LightKind::Directional { direction },
+        LightKind::Spot { position, direction, cone_angle_degrees: 30.0, falloff_exponent: 2.0 },
+    ];
+    egui::ComboBox::from_label("Type").selected_text(kind.kind_name()).show_ui(ui, |ui| {
+        for choice in choices {
+            if ui.selectable_label(choice.kind_name() == kind.kind_name(), choice.kind_name()).clicked()
+                && choice.kind_name() != kind.kind_name()
+            {
+                *kind = choice;
+            }
+        }
+    });
+    match kind {
+        LightKind::Point { position } => vec3_ui(ui, "Position", position, 0.01),
+        LightKind::Directional { direction } => vec3_ui(ui, "Direction", direction, 0.01),
+        LightKind::Spot { position, direction, cone_angle_degrees, falloff_exponent } => {
+            vec3_ui(ui, "Position", position, 0.01);
+            vec3_ui(ui, "Direction", direction, 0.01);
+            ui.add(egui::Slider::new(cone_angle_degrees, 0.1..=90.0).text("Cone half-angle °"));
+            ui.add(egui::Slider::new(falloff_exponent, 0.0..=10_000.0).logarithmic(true).text("Falloff exponent"));
+        }
+    }
+}

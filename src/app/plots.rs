@@ -1,0 +1,100 @@
+//! Plots of every pane: time per pass, samples per second over time, error
+//! against time on log–log axes, and the photon maps' statistics.
+
+use eframe::egui;
+use egui_plot::{Bar, BarChart, Legend, Line, Plot};
+
+use super::pane::Pane;
+use crate::photon::maps::RADIUS_BINS;
+
+pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
+    // A fixed height: plots asking for all the space would push the panes out
+    let height = 150.0;
+    ui.columns(4, |columns| {
+        columns[0].label("Time per pass (ms)");
+        Plot::new("pass_time").legend(Legend::default()).height(height).show(&mut columns[0], |plot| {
+            for (i, pane) in panes.iter().enumerate() {
+                let points: Vec<[f64; 2]> =
+                    pane.state.history.iter().map(|r| [r.passes as f64, r.pass_seconds * 1e3]).collect();
+                plot.line(Line::new(series_name(i, pane), points));
+            }
+        });
+        columns[1].label("Samples per second (M) over time (s)");
+        Plot::new("throughput").legend(Legend::default()).height(height).show(&mut columns[1], |plot| {
+            for (i, pane) in panes.iter().enumerate() {
+                let points: Vec<[f64; 2]> =
+                    pane.state.history.iter().map(|r| [r.seconds, r.samples_per_second / 1e6]).collect();
+                plot.line(Line::new(series_name(i, pane), points));
+            }
+        });
+        columns[2].label("log₁₀ relMSE against log₁₀ seconds");
+        Plot::new("error").legend(Legend::default()).height(height).show(&mut columns[2], |plot| {
+            for (i, pane) in panes.iter().enumerate() {
+                let points: Vec<[f64; 2]> = pane
+                    .state
+                    .history
+                    .iter()
+                    .filter_map(|r| r.error.filter(|e| *e > 0.0).map(|e| [r.seconds.max(1e-6).log10(), e.log10()]))
+                    .collect();
+                plot.line(Line::new(series_name(i, pane), points));
+            }
+        });
+        photon_ui(&mut columns[3], panes, height);
+    });
+}
+
+fn series_name(index: usize, pane: &Pane) -> String {
+    format!("{} {}", index + 1, pane.algorithm().name())
+}
+
+fn photon_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
+    ui.label("Photon maps");
+    let mut any = false;
+    for (i, pane) in panes.iter().enumerate() {
+        if let Some(maps) = &pane.state.maps {
+            any = true;
+            for (name, map) in [("global", &maps.global), ("caustic", &maps.caustic)] {
+                ui.small(format!(
+                    "{}: {name}: {} stored of {} · {:.1} MB · build {:.0} ms · depth {}",
+                    i + 1,
+                    map.stored,
+                    map.emitted,
+                    map.bytes as f64 / 1e6,
+                    map.build_time.as_secs_f64() * 1e3,
+                    map.depth
+                ));
+            }
+        }
+        if let Some(stats) = &pane.state.stats {
+            let q = &stats.photon.queries;
+            if q.queries > 0 {
+                any = true;
+                ui.small(format!(
+                    "{}: k-NN {:.0} nodes, {:.2} µs per query{}",
+                    i + 1,
+                    q.mean_nodes_visited(),
+                    q.mean_query_time().as_secs_f64() * 1e6,
+                    if stats.photon.mean_radius > 0.0 {
+                        format!(" · SPPM radius {:.4}", stats.photon.mean_radius)
+                    } else {
+                        String::new()
+                    }
+                ));
+                let bars: Vec<Bar> = q
+                    .radius_histogram
+                    .iter()
+                    .enumerate()
+                    .map(|(b, n)| {
+                        Bar::new((b as f64 + 0.5) / RADIUS_BINS as f64, *n as f64).width(0.9 / RADIUS_BINS as f64)
+                    })
+                    .collect();
+                Plot::new(("radii", i)).height(height * 0.5).show(ui, |plot| {
+                    plot.bar_chart(BarChart::new("gather radius / max", bars));
+                });
+            }
+        }
+    }
+    if !any {
+        ui.weak("Statistics appear when a pane renders with photon mapping or SPPM.");
+    }
+}

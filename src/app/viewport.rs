@@ -1,0 +1,139 @@
+//! A pane's viewport: the image fitted to the pane, its label, and the
+//! mouse: click picks the object under the cursor, drag orbits the camera
+//! about its look-at point, shift-drag pans, scroll dollies.
+
+use eframe::egui;
+use glam::{Quat, Vec3};
+
+use super::inspector::Selection;
+use super::pane::Pane;
+use crate::render::camera::CameraModel;
+use crate::render::world::World;
+use crate::scene::{Camera, Scene};
+
+/// Index of the object seen through film position (x, y) of a `width ×
+/// height` image, by the engine's own geometry.
+pub fn pick(scene: &Scene, width: u32, height: u32, x: f32, y: f32) -> Option<usize> {
+    if !scene.validate().is_empty() {
+        return None;
+    }
+    let ray = CameraModel::new(&scene.camera, width, height).pixel_ray(x, y);
+    World::new(scene).intersect(&ray, f32::INFINITY).map(|hit| hit.object as usize)
+}
+
+/// Turn the camera about its look-at point: `yaw` about the up vector,
+/// `pitch` about the camera's right vector (stopping short of the poles).
+pub fn orbit(camera: &mut Camera, yaw: f32, pitch: f32) {
+    let up = camera.up.normalize_or(Vec3::Y);
+    let offset = camera.position - camera.look_at;
+    let right = offset.cross(up).normalize_or(Vec3::X);
+    let turned = Quat::from_axis_angle(up, yaw) * offset;
+    let tilted = Quat::from_axis_angle(right, pitch) * turned;
+    // Keep away from looking straight along `up`, where the view degenerates
+    if tilted.normalize_or_zero().dot(up).abs() < 0.995 {
+        camera.position = camera.look_at + tilted;
+    } else {
+        camera.position = camera.look_at + turned;
+    }
+}
+
+/// Move position and look-at together across the view.
+pub fn pan(camera: &mut Camera, dx: f32, dy: f32) {
+    let forward = (camera.look_at - camera.position).normalize_or(Vec3::NEG_Z);
+    let right = forward.cross(camera.up).normalize_or(Vec3::X);
+    let up = right.cross(forward);
+    let distance = (camera.look_at - camera.position).length();
+    let shift = (right * -dx + up * dy) * distance;
+    camera.position += shift;
+    camera.look_at += shift;
+}
+
+/// Move toward (factor < 1) or away from the look-at point.
+pub fn dolly(camera: &mut Camera, factor: f32) {
+    let offset = camera.position - camera.look_at;
+    let scaled = offset * factor.clamp(0.5, 2.0);
+    if scaled.length() > 1e-3 {
+        camera.position = camera.look_at + scaled;
+    }
+}
+
+/// Draw the pane and apply its interactions to `scene` and `selection`.
+pub fn viewport_ui(ui: &mut egui::Ui, pane: &mut Pane, scene: &mut Scene, selection: &mut Selection) -> egui::Response {
+    let texture = pane.texture(ui.ctx()).clone();
+    let (width, height) = (pane.state.image.width as f32, pane.state.image.height as f32);
+    let available = ui.available_size();
+    let scale = (available.x / width).min(available.y / height).max(0.01);
+    let (rect, response) =
+        ui.allocate_exact_size(egui::vec2(width * scale, height * scale), egui::Sense::click_and_drag());
+    let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+    ui.painter().image(texture.id(), rect, uv, egui::Color32::WHITE);
+    let label = pane.label();
+    let font = egui::FontId::proportional(13.0);
+    let galley = ui.painter().layout_no_wrap(label, font, egui::Color32::WHITE);
+    let label_rect = egui::Rect::from_min_size(rect.min, galley.size() + egui::vec2(12.0, 6.0));
+    ui.painter().rect_filled(label_rect, 3.0, egui::Color32::from_black_alpha(160));
+    ui.painter().galley(rect.min + egui::vec2(6.0, 3.0), galley, egui::Color32::WHITE);
+    if let Some(message) = &pane.state.failed {
+        ui.painter().text(
+            rect.center(),
+            egui::Align2::CENTER_CENTER,
+            message,
+            egui::FontId::proportional(14.0),
+            ui.visuals().error_fg_color,
+        );
+    }
+
+    let to_film = |pos: egui::Pos2| ((pos.x - rect.min.x) / scale, (pos.y - rect.min.y) / scale);
+    if response.clicked() {
+        if let Some(pos) = response.interact_pointer_pos() {
+            let (x, y) = to_film(pos);
+            match pick(scene, width as u32, height as u32, x, y) {
+                Some(object) => *selection = Selection::Object(object),
+                None => *selection = Selection::Camera,
+            }
+        }
+    }
+    if response.dragged() {
+        let delta = response.drag_delta();
+        if ui.input(|i| i.modifiers.shift) {
+            pan(&mut scene.camera, delta.x / rect.height(), delta.y / rect.height());
+        } else {
+            orbit(&mut scene.camera, -delta.x * 0.01, -delta.y * 0.01);
+        }
+    }
+    if response.hovered() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            dolly(&mut scene.camera, (-scroll * 0.002).exp());
+        }
+    }
+    response
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::presets::default_scene;
+
+    #[test]
+    fn orbit_keeps_distance_and_dolly_changes_it() {
+        let mut camera = default_scene().camera;
+        let distance = (camera.position - camera.look_at).length();
+        orbit(&mut camera, 0.7, 0.3);
+        assert!(((camera.position - camera.look_at).length() - distance).abs() < 1e-4);
+        dolly(&mut camera, 0.5);
+        assert!(((camera.position - camera.look_at).length() - distance * 0.5).abs() < 1e-4);
+        let look_at = camera.look_at;
+        pan(&mut camera, 0.1, 0.0);
+        assert!((camera.look_at - look_at).length() > 0.0);
+    }
+
+    #[test]
+    fn picking_finds_the_glass_ball_in_the_cornell_box() {
+        let scene = default_scene();
+        let camera = CameraModel::new(&scene.camera, 160, 120);
+        let ball = scene.objects.iter().position(|o| o.name == "glass ball").unwrap();
+        let p = camera.project(glam::Vec3::new(0.45, 0.35, 0.2)).unwrap();
+        assert_eq!(pick(&scene, 160, 120, p.x, p.y), Some(ball));
+    }
+}
