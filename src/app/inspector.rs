@@ -125,7 +125,14 @@ fn list_ui(ui: &mut egui::Ui, _title: &str, scene: &mut Scene, selection: &mut S
     egui::CollapsingHeader::new("Lights").default_open(true).show(ui, |ui| {
         for (i, light) in scene.lights.iter_mut().enumerate() {
             ui.horizontal(|ui| {
-                ui.checkbox(&mut light.enabled, "").on_hover_text("Enabled");
+                ui.checkbox(&mut light.enabled, "").on_hover_text("Enabled").widget_info(|| {
+                    egui::WidgetInfo::selected(
+                        egui::Role::CheckBox,
+                        true,
+                        light.enabled,
+                        format!("{} enabled", light.name),
+                    )
+                });
                 ui.selectable_value(
                     selection,
                     Selection::Light(i),
@@ -174,30 +181,30 @@ fn shape_name(shape: &Shape) -> &'static str {
 
 fn vec3_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f64) {
     ui.horizontal(|ui| {
-        ui.label(label);
+        let label = ui.label(label);
         for (axis, c) in ["x", "y", "z"].into_iter().zip([&mut v.x, &mut v.y, &mut v.z]) {
-            ui.add(egui::DragValue::new(c).speed(speed).prefix(format!("{axis} ")));
+            ui.add(egui::DragValue::new(c).speed(speed).prefix(format!("{axis} "))).labelled_by(label.id);
         }
     });
 }
 
 fn scalar_ui(ui: &mut egui::Ui, label: &str, v: &mut f32, range: std::ops::RangeInclusive<f32>, speed: f64) {
     ui.horizontal(|ui| {
-        ui.label(label);
-        ui.add(egui::DragValue::new(v).speed(speed).range(range));
+        let label = ui.label(label);
+        ui.add(egui::DragValue::new(v).speed(speed).range(range)).labelled_by(label.id);
     });
 }
 
 /// A reflectance in [0, 1]: a colour picker.
 fn reflectance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) {
     ui.horizontal(|ui| {
-        ui.label(label);
+        let label = ui.label(label);
         let mut rgb = v.to_array();
-        if ui.color_edit_button_rgb(&mut rgb).changed() {
+        if ui.color_edit_button_rgb(&mut rgb).labelled_by(label.id).changed() {
             *v = Vec3::from_array(rgb).clamp(Vec3::ZERO, Vec3::ONE);
         }
         for c in [&mut v.x, &mut v.y, &mut v.z] {
-            ui.add(egui::DragValue::new(c).speed(0.005).range(0.0..=1.0));
+            ui.add(egui::DragValue::new(c).speed(0.005).range(0.0..=1.0)).labelled_by(label.id);
         }
     });
 }
@@ -205,9 +212,9 @@ fn reflectance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) {
 /// Radiance or power: unbounded above, never negative.
 fn radiance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) {
     ui.horizontal(|ui| {
-        ui.label(label);
+        let label = ui.label(label);
         for c in [&mut v.x, &mut v.y, &mut v.z] {
-            ui.add(egui::DragValue::new(c).speed(0.05).range(0.0..=f32::MAX));
+            ui.add(egui::DragValue::new(c).speed(0.05).range(0.0..=f32::MAX)).labelled_by(label.id);
         }
     });
 }
@@ -242,8 +249,8 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
                 Shape::Sphere { center, radius } => {
                     vec3_ui(ui, "Centre", center, 0.01);
                     ui.horizontal(|ui| {
-                        ui.label("Radius");
-                        ui.add(egui::DragValue::new(radius).speed(0.01).range(1e-6..=f32::MAX));
+                        let label = ui.label("Radius");
+                        ui.add(egui::DragValue::new(radius).speed(0.01).range(1e-6..=f32::MAX)).labelled_by(label.id);
                     });
                 }
                 Shape::Plane { point, normal } => {
@@ -284,11 +291,12 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
             reflectance_ui(ui, "Colour", &mut light.color);
             scalar_ui(ui, "Intensity", &mut light.intensity, 0.0..=f32::MAX, 0.1);
             if !matches!(light.kind, LightKind::Directional { .. }) {
-                ui.label("Attenuation 1/(a·d² + b·d + c)");
+                let heading = ui.label("Attenuation 1/(a·d² + b·d + c)");
                 ui.horizontal(|ui| {
                     let a = &mut light.attenuation;
                     for (label, v) in [("a", &mut a.a), ("b", &mut a.b), ("c", &mut a.c)] {
-                        ui.add(egui::DragValue::new(v).speed(0.01).range(0.0..=f32::MAX).prefix(format!("{label} ")));
+                        ui.add(egui::DragValue::new(v).speed(0.01).range(0.0..=f32::MAX).prefix(format!("{label} ")))
+                            .labelled_by(heading.id);
                     }
                 });
             }

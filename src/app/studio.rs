@@ -76,6 +76,8 @@ pub struct StudioApp {
     pub show_debug: bool,
     pub recent: Vec<PathBuf>,
     pub panes_rect: egui::Rect,
+    /// Where each pane's image was drawn last frame (screen points).
+    pub viewport_rects: Vec<egui::Rect>,
     dialog: Option<FileDialog>,
     pending: Option<Action>,
     quit_confirmed: bool,
@@ -136,6 +138,7 @@ impl StudioApp {
             show_debug: false,
             recent: persisted.recent.clone(),
             panes_rect: egui::Rect::NOTHING,
+            viewport_rects: Vec::new(),
             dialog: None,
             pending: None,
             quit_confirmed: false,
@@ -360,6 +363,11 @@ impl StudioApp {
         self.reference = LinearImage::load(&path).ok();
     }
 
+    /// Render every pane afresh at the next frame (after settings changed).
+    pub fn restart_all(&mut self) {
+        self.rendered = None;
+    }
+
     /// Restart every pane if the scene changed and is valid; invalid scenes
     /// are only flagged.
     pub fn sync_engine(&mut self) {
@@ -436,7 +444,7 @@ impl StudioApp {
             ui.horizontal(|ui| {
                 if let Some(error) = &self.error {
                     ui.colored_label(ui.visuals().error_fg_color, error);
-                    if ui.small_button("✕").clicked() {
+                    if ui.small_button("Dismiss").clicked() {
                         self.error = None;
                     }
                 } else {
@@ -495,11 +503,13 @@ impl StudioApp {
         ui.horizontal(|ui| {
             let pane = &mut self.panes[index];
             let mut algorithm = pane.settings.algorithm;
-            egui::ComboBox::from_id_salt(("algorithm", index)).selected_text(algorithm.label()).show_ui(ui, |ui| {
-                for a in Algorithm::ALL {
-                    ui.selectable_value(&mut algorithm, a, a.label());
-                }
-            });
+            egui::ComboBox::new(("algorithm", index), format!("pane {}", index + 1))
+                .selected_text(algorithm.label())
+                .show_ui(ui, |ui| {
+                    for a in Algorithm::ALL {
+                        ui.selectable_value(&mut algorithm, a, a.label());
+                    }
+                });
             if algorithm != pane.settings.algorithm {
                 pane.settings.algorithm = algorithm;
                 pane.settings.max_depth = algorithm.default_max_depth();
@@ -514,7 +524,9 @@ impl StudioApp {
             self.panes[index].restart(Arc::new(self.scene.clone()));
         }
         let pane = &mut self.panes[index];
-        viewport_ui(ui, pane, &mut self.scene, &mut self.selection);
+        let rect = viewport_ui(ui, pane, &mut self.scene, &mut self.selection).rect;
+        self.viewport_rects.resize(self.panes.len(), egui::Rect::NOTHING);
+        self.viewport_rects[index] = rect;
     }
 
     fn windows_ui(&mut self, ctx: &egui::Context) {

@@ -60,7 +60,7 @@ impl LightPicker {
     }
 
     pub fn is_empty(&self) -> bool {
-        !(self.total > 0.0)
+        self.total.is_nan() || self.total <= 0.0
     }
 
     /// (light index, probability of picking it).

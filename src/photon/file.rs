@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use super::kdtree::PhotonKdTree;
 use super::maps::{MapStats, PhotonMapStats, PhotonMaps};
-use super::photon::Photon;
+use super::record::Photon;
 use crate::render::PhotonSettings;
 
 const MAGIC: &[u8; 8] = b"GIPHOTON";

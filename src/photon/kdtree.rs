@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 
-use super::photon::Photon;
+use super::record::Photon;
 
 #[derive(Debug)]
 pub struct PhotonKdTree {
@@ -101,7 +101,7 @@ impl PhotonKdTree {
     ) -> usize {
         out.reset(k);
         let n = self.photons.len();
-        if k == 0 || n == 0 || !(max_radius >= 0.0) {
+        if k == 0 || n == 0 || max_radius.is_nan() || max_radius < 0.0 {
             return 0;
         }
         let photons = &self.photons[..];
@@ -146,7 +146,7 @@ impl PhotonKdTree {
     /// Every photon with squared distance ≤ radius² (progressive photon mapping).
     pub fn for_each_within(&self, position: Vec3, radius: f32, mut f: impl FnMut(&Photon)) {
         let n = self.photons.len();
-        if n == 0 || !(radius >= 0.0) {
+        if n == 0 || radius.is_nan() || radius < 0.0 {
             return;
         }
         let bound = radius * radius;

@@ -7,10 +7,10 @@ pub mod file;
 pub mod integrator;
 pub mod kdtree;
 pub mod maps;
-pub mod photon;
+pub mod record;
 pub mod sppm;
 pub mod trace;
 
 pub use kdtree::{Neighbours, PhotonKdTree};
 pub use maps::{PhotonMapStats, PhotonMaps, QueryStats};
-pub use photon::Photon;
+pub use record::Photon;

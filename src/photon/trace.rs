@@ -7,7 +7,7 @@
 use rayon::prelude::*;
 
 use super::emit::{emit, emit_toward, specular_targets, EmittedPhoton, LightPicker};
-use super::photon::Photon;
+use super::record::Photon;
 use crate::render::bsdf::{Bsdf, Transport};
 use crate::render::rng::Sampler;
 use crate::render::world::World;

@@ -102,7 +102,7 @@ impl LightSource {
                 let (target, normal, error, pdf) = sample_area(world, object, p, u)?;
                 let (shadow, shadow_t_max) = at.spawn_ray_to(target, error);
                 // Emission is one-sided: the light's front must face the point
-                if normal.dot(-shadow.direction) <= 0.0 || !(pdf > 0.0) {
+                if normal.dot(-shadow.direction) <= 0.0 || pdf.is_nan() || pdf <= 0.0 {
                     return None;
                 }
                 Some(LightSample { wi: shadow.direction, value: radiance / pdf, pdf, shadow, shadow_t_max })

@@ -14,7 +14,7 @@ pub enum SceneFileError {
     Syntax { path: PathBuf, line: usize, column: usize, message: String },
     /// Well-formed but a value is unusable; the position is the field's.
     #[error("{path}:{line}:{column}: {invalid}{more}", more = more_note(*.others))]
-    Invalid { path: PathBuf, line: usize, column: usize, invalid: Invalid, others: usize },
+    Invalid { path: PathBuf, line: usize, column: usize, invalid: Box<Invalid>, others: usize },
     #[error("could not write the scene: {0}")]
     Serialize(String),
 }
@@ -47,7 +47,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneFileError> {
     let others = problems.len() - 1;
     let invalid = problems.swap_remove(0);
     let (line, column) = locate(text, &invalid);
-    Err(SceneFileError::Invalid { path: path.to_owned(), line, column, invalid, others })
+    Err(SceneFileError::Invalid { path: path.to_owned(), line, column, invalid: Box::new(invalid), others })
 }
 
 pub fn to_ron(scene: &Scene) -> Result<String, SceneFileError> {

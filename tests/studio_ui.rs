@@ -1,0 +1,181 @@
+//! The studio driven as a user drives it (egui_kittest, no window).
+
+use std::path::PathBuf;
+
+use eframe::egui;
+use egui::accesskit::Role;
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use gi_studio::app::{Selection, StudioApp};
+use gi_studio::cli::StudioArgs;
+use gi_studio::render::camera::CameraModel;
+use gi_studio::scene::Shape;
+
+fn studio(panes: usize) -> Harness<'static, StudioApp> {
+    let args = StudioArgs { panes: Some(panes), ..Default::default() };
+    let mut app = StudioApp::new(&egui::Context::default(), None, &args);
+    // Small images keep the tests quick
+    for pane in &mut app.panes {
+        pane.settings.width = 64;
+        pane.settings.height = 48;
+        pane.settings.samples_per_pixel = Some(2);
+        pane.settings.photon.global_photons = 5_000;
+        pane.settings.photon.caustic_photons = 5_000;
+        pane.settings.photon.sppm_photons_per_pass = 5_000;
+    }
+    app.restart_all();
+    Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app)
+}
+
+/// Step until `done` holds (tiles arrive from the worker over several frames).
+fn step_until(harness: &mut Harness<'static, StudioApp>, done: impl Fn(&StudioApp) -> bool) {
+    for _ in 0..3000 {
+        harness.step();
+        if done(harness.state()) {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    panic!("condition not reached");
+}
+
+fn radius_of(app: &StudioApp, name: &str) -> f32 {
+    match app.scene.objects.iter().find(|o| o.name == name).map(|o| &o.shape) {
+        Some(Shape::Sphere { radius, .. }) => *radius,
+        _ => panic!("no sphere {name}"),
+    }
+}
+
+#[test]
+fn editing_a_radius_in_the_inspector_restarts_and_undo_redo_restore_both_states() {
+    let mut harness = studio(1);
+    step_until(&mut harness, |app| app.panes[0].state.passes() >= 1);
+    let original = harness.state().scene.clone();
+    let generation = harness.state().generations()[0];
+    harness.get_by_label("mirror ball (sphere)").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().selection, Selection::Object(5));
+    let radius = harness.get_by_role_and_label(Role::SpinButton, "Radius");
+    radius.click();
+    harness.run_steps(2);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_role_and_label(Role::SpinButton, "Radius").type_text("0.2");
+    harness.key_press(egui::Key::Enter);
+    harness.run_steps(3);
+    assert_eq!(radius_of(harness.state(), "mirror ball"), 0.2);
+    assert!(harness.state().generations()[0] > generation, "the edit must restart the render");
+    let edited = harness.state().scene.clone();
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(harness.state().scene, original);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(harness.state().scene, edited);
+}
+
+#[test]
+fn toggling_a_light_changes_the_scene_and_restarts() {
+    let mut harness = studio(1);
+    harness.state_mut().open_path(&PathBuf::from("assets/scenes/thesis.ron"));
+    harness.state_mut().panes[0].settings.width = 64;
+    harness.state_mut().panes[0].settings.height = 48;
+    harness.state_mut().restart_all();
+    harness.run_steps(2);
+    let generation = harness.state().generations()[0];
+    assert!(harness.state().scene.lights[0].enabled);
+    harness.get_all_by_role(Role::CheckBox).next().expect("a light checkbox").click();
+    harness.run_steps(2);
+    assert!(!harness.state().scene.lights[0].enabled);
+    assert!(harness.state().generations()[0] > generation);
+}
+
+#[test]
+fn a_broken_file_shows_its_error_and_leaves_the_scene_unchanged() {
+    let mut harness = studio(1);
+    harness.run_steps(2);
+    let before = harness.state().scene.clone();
+    let dir = std::env::temp_dir().join(format!("gi-ui-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("broken.ron");
+    std::fs::write(&path, include_str!("../assets/scenes/cornell.ron").replacen("ior: 1.5", "ior: -2.0", 1)).unwrap();
+    harness.state_mut().open_path(&path);
+    harness.run_steps(2);
+    assert_eq!(harness.state().scene, before);
+    let error = harness.state().error.clone().expect("an error is shown");
+    assert!(error.contains("broken.ron:") && error.contains("ior"), "{error}");
+    harness.get_by_label_contains("broken.ron:");
+}
+
+#[test]
+fn four_panes_show_four_algorithms() {
+    let mut harness = studio(1);
+    harness.run_steps(2);
+    harness.get_by_label("View").click();
+    harness.run_steps(2);
+    harness.get_by_label("4 panes").click();
+    harness.run_steps(3);
+    let app = harness.state();
+    assert_eq!(app.panes.len(), 4);
+    let mut algorithms: Vec<_> = app.panes.iter().map(|p| p.algorithm()).collect();
+    algorithms.dedup();
+    assert_eq!(algorithms.len(), 4);
+    assert_eq!(algorithms, gi_studio::render::Algorithm::ALL.to_vec());
+    for pane in 1..=4 {
+        harness.get_by_label(&format!("pane {pane}"));
+    }
+}
+
+#[test]
+fn exporting_a_pane_writes_a_png_of_the_panes_size() {
+    let mut harness = studio(1);
+    step_until(&mut harness, |app| app.panes[0].state.passes() >= 1);
+    let path = std::env::temp_dir().join(format!("gi-ui-export-{}.png", std::process::id()));
+    harness.state_mut().export_pane(0, &path);
+    let decoded = image::open(&path).expect("a PNG");
+    assert_eq!((decoded.width(), decoded.height()), (64, 48));
+}
+
+#[test]
+fn clicking_a_sphere_in_the_viewport_selects_it() {
+    let mut harness = studio(1);
+    step_until(&mut harness, |app| app.panes[0].state.passes() >= 1);
+    let app = harness.state();
+    let rect = app.viewport_rects[0];
+    let camera = CameraModel::new(&app.scene.camera, 64, 48);
+    let film = camera.project(glam::Vec3::new(0.45, 0.35, 0.2)).expect("in view");
+    let target = rect.min + egui::vec2(film.x / 64.0 * rect.width(), film.y / 48.0 * rect.height());
+    let glass = app.scene.objects.iter().position(|o| o.name == "glass ball").unwrap();
+    harness.hover_at(target);
+    harness.run_steps(1);
+    harness.event(egui::Event::PointerButton {
+        pos: target,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: Default::default(),
+    });
+    harness.run_steps(1);
+    harness.event(egui::Event::PointerButton {
+        pos: target,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: Default::default(),
+    });
+    harness.run_steps(2);
+    assert_eq!(harness.state().selection, Selection::Object(glass));
+}
+
+#[test]
+fn every_menu_opens_and_draws() {
+    let mut harness = studio(1);
+    harness.run_steps(2);
+    for (menu, entry) in
+        [("File", "Open…"), ("Edit", "Undo"), ("View", "Plots"), ("Help", "Drop a .ron file on the window to open it.")]
+    {
+        harness.get_by_label(menu).click();
+        harness.run_steps(2);
+        harness.get_by_label_contains(entry);
+        harness.key_press(egui::Key::Escape);
+        harness.run_steps(2);
+    }
+}
