@@ -8,7 +8,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use gi_studio::geometry::{intersect_sphere, Ray};
 use gi_studio::render::rng::Sampler;
 use gi_studio::render::sampling::uniform_sphere;
-use gi_studio::render::{render_blocking, Algorithm, RenderJob, RenderSettings};
+use gi_studio::render::{render_blocking, Algorithm, RenderEvent, RenderJob, RenderSession, RenderSettings};
 use gi_studio::scene::presets;
 use glam::Vec3;
 
@@ -46,5 +46,56 @@ fn path_smallpt(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, ray_sphere, path_smallpt);
+/// Whitted on cornell.ron at 640×480: one anti-aliased pass is one frame.
+fn whitted_cornell(c: &mut Criterion) {
+    let scene = Arc::new(presets::preset("cornell").and_then(Result::ok).expect("cornell preset"));
+    let settings = RenderSettings {
+        width: 640,
+        height: 480,
+        samples_per_pixel: Some(1),
+        ..RenderSettings::for_algorithm(Algorithm::Whitted)
+    };
+    let job = RenderJob::new(scene.clone(), settings.clone());
+    let mut group = c.benchmark_group("render");
+    group.sample_size(20);
+    group.bench_function("whitted_cornell_640x480_frame", |b| b.iter(|| render_blocking(&job).map(|r| r.1.rays)));
+    // The studio's case: a long-lived session restarted by an edit; time
+    // until the whole coarse preview has arrived
+    let session = RenderSession::new(None);
+    let preview = RenderJob::new(scene, RenderSettings { preview: true, samples_per_pixel: Some(0), ..settings });
+    group.bench_function("whitted_cornell_640x480_first_coarse_frame_after_edit", |b| {
+        b.iter(|| {
+            let generation = session.start(preview.clone());
+            for event in session.events().iter() {
+                if let RenderEvent::Finished { generation: g, .. } = event {
+                    if g == generation {
+                        break;
+                    }
+                }
+            }
+        })
+    });
+    group.finish();
+}
+
+/// SPPM on caustics.ron at 512×384 with 1 M photons per pass: one pass.
+fn sppm_caustics(c: &mut Criterion) {
+    let scene = Arc::new(presets::preset("caustics").and_then(Result::ok).expect("caustics preset"));
+    let mut settings = RenderSettings {
+        width: 512,
+        height: 384,
+        samples_per_pixel: Some(1),
+        ..RenderSettings::for_algorithm(Algorithm::Sppm)
+    };
+    settings.photon.sppm_photons_per_pass = 1_000_000;
+    let job = RenderJob::new(scene, settings);
+    let mut group = c.benchmark_group("render");
+    group.sample_size(10);
+    group.bench_function("sppm_caustics_512x384_1M_photons_pass", |b| {
+        b.iter(|| render_blocking(&job).map(|r| r.1.rays))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, ray_sphere, path_smallpt, whitted_cornell, sppm_caustics);
 criterion_main!(benches);

@@ -2,7 +2,7 @@
 //! (with optional outlier rejection), SSIM on tone-mapped luminance, and
 //! per-pixel relative error in false colour.
 
-use crate::render::image::{srgb_encode, LinearImage};
+use crate::render::image::{srgb_encode, tonemap_srgb8, LinearImage};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MetricError {
@@ -144,6 +144,19 @@ pub fn ssim(test: &LinearImage, reference: &LinearImage, exposure: f32) -> Resul
     Ok(total / (w * h) as f64)
 }
 
+/// Mean FLIP (Andersson et al. 2020, NVIDIA's reference implementation) of
+/// the tone-mapped sRGB images: the perceived difference, 0 for identical.
+pub fn flip(test: &LinearImage, reference: &LinearImage, exposure: f32) -> Result<f64, MetricError> {
+    check(test, reference)?;
+    let srgb =
+        |image: &LinearImage| -> Vec<u8> { image.pixels.iter().flat_map(|p| tonemap_srgb8(*p, exposure)).collect() };
+    let (width, height) = (test.width, test.height);
+    let reference = nv_flip::FlipImageRgb8::with_data(width, height, &srgb(reference));
+    let test = nv_flip::FlipImageRgb8::with_data(width, height, &srgb(test));
+    let map = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    Ok(nv_flip::FlipPool::from_image(&map).mean() as f64)
+}
+
 /// Magma-like control points, dark (no error) to bright (large error).
 const MAGMA: [[u8; 3]; 9] = [
     [0, 0, 4],
@@ -256,6 +269,15 @@ mod tests {
             assert!(s < last, "amplitude {amplitude}: {s} ≥ {last}");
             last = s;
         }
+    }
+
+    #[test]
+    fn flip_is_zero_for_identical_and_grows_with_noise() {
+        let a = gradient();
+        assert_eq!(flip(&a, &a, 0.0).unwrap(), 0.0);
+        let small = flip(&noisy(&a, 0.05, 3), &a, 0.0).unwrap();
+        let large = flip(&noisy(&a, 0.5, 3), &a, 0.0).unwrap();
+        assert!(small > 0.0 && large > small, "{small} {large}");
     }
 
     #[test]

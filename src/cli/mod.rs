@@ -1,7 +1,9 @@
 //! The headless side of the binary: `render` (and, as they land, `photons`,
 //! `reference`, `bench`). Errors become `anyhow` here, at the edge.
 
+pub mod bench;
 pub mod photons;
+pub mod reference;
 pub mod render;
 
 use std::path::PathBuf;
@@ -46,6 +48,10 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Trace a scene's photon maps once and save them for `render --photon-map`.
     Photons(photons::PhotonsArgs),
+    /// Render converged path-traced references (EXR, with metadata beside them).
+    Reference(reference::ReferenceArgs),
+    /// Speed against error: every algorithm for the same time budget, against references.
+    Bench(bench::BenchArgs),
 }
 
 /// Flags shared by every command that renders.

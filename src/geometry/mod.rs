@@ -13,7 +13,8 @@ pub use plane::intersect_plane;
 pub(crate) use plane::{plane_hit, plane_t};
 pub use ray::{gamma, offset_ray_origin, Ray};
 pub use sphere::intersect_sphere;
-pub(crate) use sphere::{sphere_hit, sphere_t};
+pub(crate) use sphere::sphere_hit;
+pub use sphere::sphere_t;
 pub use triangle::{intersect_triangle, Triangle};
 
 use glam::Vec3;

@@ -48,20 +48,7 @@ pub(crate) fn spawn_offset_scale(p: Vec3) -> f32 {
 pub fn offset_ray_origin(point: Vec3, error: f32, normal: Vec3, direction: Vec3) -> Vec3 {
     let distance = error * normal.abs().element_sum() + spawn_offset_scale(point);
     let offset = if direction.dot(normal) < 0.0 { -normal * distance } else { normal * distance };
-    let moved = point + offset;
-    // Round away from the point so the offset survives the addition.
-    Vec3::new(next_away(moved.x, offset.x), next_away(moved.y, offset.y), next_away(moved.z, offset.z))
-}
-
-#[inline]
-fn next_away(v: f32, offset: f32) -> f32 {
-    if offset > 0.0 {
-        v.next_up()
-    } else if offset < 0.0 {
-        v.next_down()
-    } else {
-        v
-    }
+    point + offset
 }
 
 #[cfg(test)]

@@ -18,7 +18,7 @@ pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32, t_max: f32) -> Opt
 /// without building the hit record (the nearest-hit loop only needs `t`).
 /// Which root matters: from far away both round to the same `t`.
 #[inline]
-pub(crate) fn sphere_t(ray: &Ray, center: Vec3, radius: f32, t_max: f32) -> Option<(f32, bool)> {
+pub fn sphere_t(ray: &Ray, center: Vec3, radius: f32, t_max: f32) -> Option<(f32, bool)> {
     // Compute the quadratic's terms relative to the closest approach
     let f = ray.origin - center;
     let b = f.dot(ray.direction);

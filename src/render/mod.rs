@@ -10,6 +10,7 @@ pub mod path;
 pub mod rng;
 pub mod sampling;
 pub mod settings;
+pub mod spheres;
 pub mod tiles;
 pub mod whitted;
 pub mod world;

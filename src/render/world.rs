@@ -5,8 +5,9 @@
 use glam::Vec3;
 
 use super::light::LightSource;
+use super::spheres::SphereLanes;
 use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
-use crate::geometry::{plane_hit, plane_t, sphere_hit, sphere_t};
+use crate::geometry::{plane_hit, plane_t, sphere_hit};
 use crate::scene::{LightKind, MaterialModel, Rgb, Scene, Shape};
 
 /// Which flat array an object's shape lives in, and where.
@@ -33,6 +34,8 @@ pub struct Spheres {
     pub center_z: Vec<f32>,
     pub radius: Vec<f32>,
     pub object: Vec<u32>,
+    /// The same spheres four to a SIMD group, for the hit loops.
+    pub lanes: SphereLanes,
 }
 
 impl Spheres {
@@ -117,6 +120,8 @@ impl World {
             };
             world.objects.push(ObjectInfo { shape, material, light: None });
         }
+        let centers: Vec<Vec3> = (0..world.spheres.radius.len()).map(|i| world.spheres.center(i)).collect();
+        world.spheres.lanes = SphereLanes::new(&centers, &world.spheres.radius);
         if lo.x <= hi.x {
             world.bounds_center = (lo + hi) * 0.5;
             world.bounds_radius = (hi - lo).length() * 0.5;
@@ -167,12 +172,10 @@ impl World {
         let mut best = None;
         let mut sphere_near = true;
         let s = &self.spheres;
-        for i in 0..s.radius.len() {
-            if let Some((t, near)) = sphere_t(ray, s.center(i), s.radius[i], best_t) {
-                best_t = t;
-                best = Some(ShapeRef::Sphere(i as u32));
-                sphere_near = near;
-            }
+        if let Some((i, t, near)) = s.lanes.nearest(ray, best_t) {
+            best_t = t;
+            best = Some(ShapeRef::Sphere(i as u32));
+            sphere_near = near;
         }
         for (i, plane) in self.planes.iter().enumerate() {
             if let Some(t) = plane_t(ray, plane.normal, plane.offset, best_t) {
@@ -206,8 +209,7 @@ impl World {
     /// first blocker.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        let s = &self.spheres;
-        (0..s.radius.len()).any(|i| sphere_t(ray, s.center(i), s.radius[i], t_max).is_some())
+        self.spheres.lanes.any_hit(ray, t_max)
             || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
             || self.triangles.iter().any(|(t, _)| intersect_triangle(ray, t, t_max).is_some())
     }

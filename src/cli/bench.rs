@@ -1,0 +1,227 @@
+//! `gi-studio bench`: speed against error. Every algorithm renders every
+//! scene for the same wall-clock budget; after each pass the image is
+//! compared with the scene's converged reference. Prints a table and writes
+//! a CSV, a log–log plot and the final images.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::reference::stem;
+use crate::analysis::convergence::{ConvergenceLog, ConvergencePoint};
+use crate::analysis::metrics::{flip, rel_mse, RelMseOptions};
+use crate::analysis::plot::plot_error_against_time;
+use crate::render::{Algorithm, LinearImage, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
+use crate::scene::{load_scene, Scene};
+
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Scene files; every preset with a reference in assets/references if none.
+    pub scenes: Vec<PathBuf>,
+    /// Seconds each algorithm renders each scene.
+    #[arg(long, default_value_t = 10.0)]
+    pub budget: f64,
+    /// Comma-separated algorithms.
+    #[arg(long, value_delimiter = ',', default_value = "whitted,path,photon,sppm")]
+    pub algos: Vec<Algorithm>,
+    /// Folder of references named <scene>.exr.
+    #[arg(long, default_value = "assets/references")]
+    pub references: PathBuf,
+    /// Where the CSV, plots and final images go.
+    #[arg(long, default_value = "bench-results")]
+    pub out: PathBuf,
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+/// One algorithm on one scene.
+pub struct Run {
+    pub algorithm: Algorithm,
+    pub log: ConvergenceLog,
+    pub stats: PassStats,
+    pub image: LinearImage,
+}
+
+/// Render `scene` with `settings` until its budget, logging error against
+/// `reference` after every pass (FLIP at roughly log-spaced times).
+pub fn measure(
+    scene: &Scene,
+    settings: RenderSettings,
+    reference: &LinearImage,
+    progress: Option<&ProgressBar>,
+) -> Result<Run> {
+    let session = RenderSession::new(None);
+    let (width, height) = (settings.width, settings.height);
+    let algorithm = settings.algorithm;
+    let generation = session.start(RenderJob::new(Arc::new(scene.clone()), settings));
+    let mut image = LinearImage::new(width, height);
+    let mut log = ConvergenceLog::default();
+    let mut next_flip = 0.0;
+    loop {
+        let event = session.events().recv().context("the render worker stopped")?;
+        if event.generation() != generation {
+            continue;
+        }
+        match event {
+            RenderEvent::Tile(tile) if !tile.preview => {
+                let rect = tile.rect;
+                for (i, pixel) in tile.pixels.into_iter().enumerate() {
+                    let (x, y) = (rect.x + i as u32 % rect.width, rect.y + i as u32 / rect.width);
+                    image.pixels[(y * width + x) as usize] = pixel;
+                }
+            }
+            RenderEvent::PassFinished { stats, .. } => {
+                let seconds = stats.elapsed.as_secs_f64();
+                let flip_now = seconds >= next_flip;
+                if flip_now {
+                    next_flip = seconds * 1.5;
+                }
+                log.push(ConvergencePoint {
+                    seconds,
+                    samples_per_pixel: stats.passes,
+                    rays: stats.rays,
+                    rel_mse: rel_mse(&image, reference, RelMseOptions::default())?,
+                    flip: if flip_now { Some(flip(&image, reference, 0.0)?) } else { None },
+                });
+                if let Some(bar) = progress {
+                    bar.set_position((seconds * 10.0) as u64);
+                }
+            }
+            RenderEvent::Finished { image: last, stats, .. } => {
+                let image = Arc::try_unwrap(last).unwrap_or_else(|shared| (*shared).clone());
+                if let Some(point) = log.points.last_mut() {
+                    point.flip = Some(flip(&image, reference, 0.0)?);
+                }
+                return Ok(Run { algorithm, log, stats, image });
+            }
+            RenderEvent::Failed { message, .. } => bail!("{algorithm}: {message}"),
+            _ => {}
+        }
+    }
+}
+
+fn format_time(t: Option<f64>) -> String {
+    t.map_or("—".into(), |t| format!("{t:.2} s"))
+}
+
+fn format_error(e: Option<f64>) -> String {
+    e.map_or("—".into(), |e| format!("{e:.2e}"))
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    if args.budget.is_nan() || args.budget <= 0.0 {
+        bail!("--budget must be a positive number of seconds");
+    }
+    let scenes: Vec<PathBuf> = if args.scenes.is_empty() {
+        crate::scene::presets::names()
+            .map(|n| PathBuf::from(format!("assets/scenes/{n}.ron")))
+            .filter(|p| args.references.join(format!("{}.exr", stem(p))).exists())
+            .collect()
+    } else {
+        args.scenes.clone()
+    };
+    if scenes.is_empty() {
+        bail!("no scenes with references in {}", args.references.display());
+    }
+    std::fs::create_dir_all(&args.out).with_context(|| args.out.display().to_string())?;
+    let mut csv = String::from("scene,algorithm,seconds,spp,rays,relmse,flip\n");
+    for scene_path in &scenes {
+        let name = stem(scene_path);
+        let scene = load_scene(scene_path)?;
+        let reference_path = args.references.join(format!("{name}.exr"));
+        let reference = LinearImage::load(&reference_path).with_context(|| format!("the reference for {name}"))?;
+        println!(
+            "\n{name} at {}×{} for {} s per algorithm (reference {})",
+            reference.width,
+            reference.height,
+            args.budget,
+            reference_path.display()
+        );
+        let mut runs = Vec::new();
+        for &algorithm in &args.algos {
+            let settings = RenderSettings {
+                width: reference.width,
+                height: reference.height,
+                time_limit: Some(args.budget),
+                samples_per_pixel: None,
+                threads: args.threads,
+                seed: args.seed,
+                ..RenderSettings::for_algorithm(algorithm)
+            };
+            let bar = ProgressBar::new((args.budget * 10.0).ceil() as u64).with_message(format!("{name} {algorithm}"));
+            bar.set_style(
+                ProgressStyle::with_template("{msg:24} [{bar:40}] {elapsed}")
+                    .unwrap_or_else(|_| ProgressStyle::default_bar())
+                    .progress_chars("=> "),
+            );
+            bar.enable_steady_tick(Duration::from_millis(200));
+            let run = measure(&scene, settings, &reference, Some(&bar))?;
+            bar.finish_and_clear();
+            for p in &run.log.points {
+                let flip = p.flip.map_or(String::new(), |f| format!("{f:.5}"));
+                writeln!(
+                    csv,
+                    "{name},{algorithm},{:.4},{},{},{:.6e},{flip}",
+                    p.seconds, p.samples_per_pixel, p.rays, p.rel_mse
+                )?;
+            }
+            run.image.save(&args.out.join(format!("{name}-{algorithm}.png")), 0.0)?;
+            runs.push(run);
+        }
+        println!("{}", table(&runs, args.budget));
+        let series: Vec<(String, ConvergenceLog)> =
+            runs.iter().map(|r| (r.algorithm.label().to_owned(), r.log.clone())).collect();
+        let plot_path = args.out.join(format!("{name}.png"));
+        plot_error_against_time(&format!("{name}: relMSE against time"), &series, &plot_path)
+            .map_err(anyhow::Error::msg)?;
+        println!("plot → {}", plot_path.display());
+    }
+    let csv_path = args.out.join("convergence.csv");
+    std::fs::write(&csv_path, csv).with_context(|| csv_path.display().to_string())?;
+    println!("\nCSV → {}", csv_path.display());
+    Ok(())
+}
+
+pub fn table(runs: &[Run], budget: f64) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{:<28} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10} {:>7} {:>8}",
+        "algorithm",
+        "M samp/s",
+        "M rays/s",
+        "relMSE 1s",
+        "relMSE 4s",
+        "at budget",
+        "t(1e-2)",
+        "t(1e-3)",
+        "slope",
+        "FLIP"
+    );
+    for run in runs {
+        let log = &run.log;
+        let last = log.points.last();
+        let _ = writeln!(
+            out,
+            "{:<28} {:>10.2} {:>10.2} {:>10} {:>10} {:>10} {:>10} {:>10} {:>7} {:>8}",
+            run.algorithm.label(),
+            run.stats.samples_per_second() / 1e6,
+            run.stats.rays_per_second() / 1e6,
+            format_error(log.error_at(1.0)),
+            format_error(log.error_at(4.0)),
+            format_error(log.error_at(budget).or(last.map(|p| p.rel_mse))),
+            format_time(log.time_to_reach(1e-2)),
+            format_time(log.time_to_reach(1e-3)),
+            log.loglog_slope().map_or("—".into(), |s| format!("{s:.2}")),
+            last.and_then(|p| p.flip).map_or("—".into(), |f| format!("{f:.4}")),
+        );
+    }
+    out
+}
