@@ -34,7 +34,7 @@ fn render(scene: &Scene, settings: RenderSettings) -> (LinearImage, u64) {
     (image, stats.non_finite)
 }
 
-/// 1. smallpt's box: camera rays start inside the front wall's sphere, and
+/// Case 1: smallpt's box: camera rays start inside the front wall's sphere, and
 /// no bounce off a wall finds the same wall again right where it started.
 #[test]
 fn case_01_smallpt_walls_no_acne() {
@@ -67,7 +67,7 @@ fn case_01_smallpt_walls_no_acne() {
     }
 }
 
-/// 2. A radius-0.1 sphere hit by a ray from (−1e7, 0.095, 0) along +x.
+/// Case 2: A radius-0.1 sphere hit by a ray from (−1e7, 0.095, 0) along +x.
 #[test]
 fn case_02_tiny_sphere_from_afar() {
     let hit =
@@ -77,7 +77,7 @@ fn case_02_tiny_sphere_from_afar() {
     assert!((hit.normal.as_dvec3() - expected / 0.1).length() < 1e-5);
 }
 
-/// 3. A sphere 8e5 units away seen from z = 1000: shading matches the f64
+/// Case 3: A sphere 8e5 units away seen from z = 1000: shading matches the f64
 /// oracle pixel by pixel (rings would be errors of the hit normal).
 #[test]
 fn case_03_distant_sphere_has_no_rings() {
@@ -116,7 +116,7 @@ fn case_03_distant_sphere_has_no_rings() {
     }
 }
 
-/// 4. Tangent rays (discriminant ≈ 0): never the square root of a negative.
+/// Case 4: Tangent rays (discriminant ≈ 0): never the square root of a negative.
 #[test]
 fn case_04_tangent_rays() {
     for i in 0..4000 {
@@ -132,7 +132,7 @@ fn case_04_tangent_rays() {
     }
 }
 
-/// 5. Re-intersection sweep: hits at scales 1e-8 … 1e8; rays leaving a
+/// Case 5: Re-intersection sweep: hits at scales 1e-8 … 1e8; rays leaving a
 /// surface never re-hit it, rays entering a sphere reach its far side, and
 /// shadow rays toward points outside are never blocked by it.
 #[test]
@@ -254,7 +254,7 @@ fn icosphere(subdivisions: u32) -> Vec<[Vec3; 3]> {
     triangles
 }
 
-/// 6. A closed triangulated sphere: rays from inside, aimed exactly at
+/// Case 6: A closed triangulated sphere: rays from inside, aimed exactly at
 /// vertices, edge midpoints and at random, always hit (watertight).
 #[test]
 fn case_06_closed_mesh_is_watertight() {
@@ -274,7 +274,7 @@ fn case_06_closed_mesh_is_watertight() {
     }
 }
 
-/// 7. Degenerate triangles (zero area, collinear, far from the origin): never
+/// Case 7: Degenerate triangles (zero area, collinear, far from the origin): never
 /// hit, never NaN, and a scene holding them renders finite.
 #[test]
 fn case_07_degenerate_triangles() {
@@ -300,7 +300,7 @@ fn case_07_degenerate_triangles() {
     assert_eq!(non_finite, 0);
 }
 
-/// 8. Nested surfaces 4e-5 apart: after the outer sphere the inner is found.
+/// Case 8: Nested surfaces 4e-5 apart: after the outer sphere the inner is found.
 #[test]
 fn case_08_nested_spheres() {
     let (inner, outer) = (1.0f32, 1.0f32 + 4.0e-5);
@@ -348,7 +348,7 @@ fn scaled_scene(scale: f32) -> Scene {
     scene
 }
 
-/// 9. The same scene scaled by 1e-3 … 1e7 renders the same image.
+/// Case 9: The same scene scaled by 1e-3 … 1e7 renders the same image.
 #[test]
 fn case_09_scale_sweep() {
     let base = render(&scaled_scene(1.0), settings(Algorithm::Whitted, 48, 36, 2)).0;
@@ -359,7 +359,7 @@ fn case_09_scale_sweep() {
     }
 }
 
-/// 10. Long rays (t ≈ 1e6) land on the surface and leave it cleanly.
+/// Case 10: Long rays (t ≈ 1e6) land on the surface and leave it cleanly.
 #[test]
 fn case_10_long_rays() {
     let mut s = Sampler::new(10, 0, 10);
@@ -378,7 +378,7 @@ fn case_10_long_rays() {
     assert!((far.t - (1.0e6 - 10.0)).abs() < 0.1);
 }
 
-/// 11. Axis-aligned directions with ±0.0 components, origins exactly on a
+/// Case 11: Axis-aligned directions with ±0.0 components, origins exactly on a
 /// plane, rays parallel to a plane.
 #[test]
 fn case_11_signed_zeros_and_planes() {
@@ -406,7 +406,7 @@ fn case_11_signed_zeros_and_planes() {
     .is_none());
 }
 
-/// 12. Glass: a lossless ball in a white furnace reflects and transmits
+/// Case 12: Glass: a lossless ball in a white furnace reflects and transmits
 /// everything (radiance 1); from inside the ball radiance is n² = 2.25;
 /// total internal reflection at grazing angles.
 #[test]
@@ -436,7 +436,7 @@ fn case_12_glass() {
     }
 }
 
-/// 13. Inside a unit sphere of albedo ½ with a point light of intensity π at
+/// Case 13: Inside a unit sphere of albedo ½ with a point light of intensity π at
 /// its centre, full global illumination converges to radiance 1 — for the
 /// path tracer and for progressive photon mapping; Whitted gives the direct ½.
 #[test]
@@ -516,7 +516,7 @@ fn chi_square(bsdf: &Bsdf, wo: Vec3) -> (f64, usize) {
     (statistic, dof.saturating_sub(1))
 }
 
-/// 14. White furnace per material: reflected energy ≤ 1 at every angle; BSDF
+/// Case 14: White furnace per material: reflected energy ≤ 1 at every angle; BSDF
 /// sampling passes a χ² test against its pdf.
 #[test]
 fn case_14_energy_and_chi_square_per_material() {
@@ -559,7 +559,7 @@ fn case_14_energy_and_chi_square_per_material() {
     }
 }
 
-/// 15. Samples with u → 1, zero-length normals and a = b = c = 0 refused,
+/// Case 15: Samples with u → 1, zero-length normals and a = b = c = 0 refused,
 /// spot exponents 0 and 10⁴, a light exactly on a surface.
 #[test]
 fn case_15_degenerate_inputs() {
@@ -596,7 +596,7 @@ fn case_15_degenerate_inputs() {
     }
 }
 
-/// 16. Photon-map estimates on awkward maps stay finite: 0 photons, k > n,
+/// Case 16: Photon-map estimates on awkward maps stay finite: 0 photons, k > n,
 /// all photons at one point (r = 0), fewer than 8 found, photons from behind.
 #[test]
 fn case_16_awkward_photon_maps() {
@@ -626,7 +626,7 @@ fn case_16_awkward_photon_maps() {
     assert_eq!(results[3], Vec3::ZERO);
 }
 
-/// 17. SPPM after thousands of passes: radius positive and finite.
+/// Case 17: SPPM after thousands of passes: radius positive and finite.
 #[test]
 fn case_17_sppm_thousands_of_passes() {
     let scene = presets::preset("cornell").unwrap().unwrap();
@@ -656,7 +656,7 @@ fn case_17_sppm_thousands_of_passes() {
     assert!(last_radius < f32::INFINITY);
 }
 
-/// 18. Fireflies: a tiny bright light behind glass. The film stays finite;
+/// Case 18: Fireflies: a tiny bright light behind glass. The film stays finite;
 /// clamping is off by default and, when asked for, visibly bounds pixels.
 #[test]
 fn case_18_fireflies() {
@@ -767,7 +767,7 @@ fn erfc(x: f64) -> f64 {
     }
 }
 
-/// 19. Statistical regression: low-spp path-traced renders against the
+/// Case 19: Statistical regression: low-spp path-traced renders against the
 /// stored reference, per pixel, by a Z-test with Šidák correction. A bias
 /// (here a 3% scale) fails it; the noise does not.
 ///
@@ -806,7 +806,7 @@ fn case_19_statistical_regression_against_references() {
     }
 }
 
-/// 20. Photon mapping's bias: fixed-k photon mapping's error plateaus while
+/// Case 20: Photon mapping's bias: fixed-k photon mapping's error plateaus while
 /// SPPM's keeps falling.
 #[test]
 fn case_20_photon_mapping_plateaus_sppm_does_not() {
