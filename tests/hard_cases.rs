@@ -685,25 +685,6 @@ fn case_18_fireflies() {
     assert!(free.pixels.iter().flatten().cloned().fold(0.0, f32::max) > 1.0, "the unclamped film keeps its fireflies");
 }
 
-/// Box-filter `image` down by an integer factor.
-fn downsample(image: &LinearImage, factor: u32) -> LinearImage {
-    let (w, h) = (image.width / factor, image.height / factor);
-    let mut out = LinearImage::new(w, h);
-    for y in 0..h {
-        for x in 0..w {
-            let mut sum = [0.0f64; 3];
-            for dy in 0..factor {
-                for dx in 0..factor {
-                    let p = image.get(x * factor + dx, y * factor + dy);
-                    (0..3).for_each(|c| sum[c] += p[c] as f64);
-                }
-            }
-            out.pixels[(y * w + x) as usize] = sum.map(|s| (s / (factor * factor) as f64) as f32);
-        }
-    }
-    out
-}
-
 /// Per-pixel Z-test of `replicas` independent renders against `reference`
 /// with Šidák correction (as Mitsuba 3 tests its renders): the smallest
 /// corrected p-value's z, and the critical z.
@@ -784,7 +765,7 @@ fn case_19_statistical_regression_against_references() {
         let path = format!("{}/assets/references/{name}.exr", env!("CARGO_MANIFEST_DIR"));
         let full = LinearImage::load(std::path::Path::new(&path)).expect("the stored reference");
         let factor = 8;
-        let reference = downsample(&full, factor);
+        let reference = full.downsample(factor);
         let replicas: Vec<LinearImage> = (0..32)
             .map(|seed| {
                 let mut s = settings(Algorithm::Path, reference.width, reference.height, 64);
@@ -812,7 +793,7 @@ fn case_19_statistical_regression_against_references() {
 fn case_20_photon_mapping_plateaus_sppm_does_not() {
     let scene = presets::preset("caustics").unwrap().unwrap();
     let path = format!("{}/assets/references/caustics.exr", env!("CARGO_MANIFEST_DIR"));
-    let reference = downsample(&LinearImage::load(std::path::Path::new(&path)).unwrap(), 8);
+    let reference = LinearImage::load(std::path::Path::new(&path)).unwrap().downsample(8);
     let error = |algorithm: Algorithm, passes: u32| {
         let mut s = settings(algorithm, reference.width, reference.height, passes);
         s.photon.global_photons = 20_000;

@@ -80,7 +80,10 @@ impl PaneState {
             }
             RenderEvent::PhotonMaps { stats, .. } => self.maps = Some(stats),
             RenderEvent::PassFinished { stats, .. } => {
-                let error = reference.and_then(|r| rel_mse(&self.image, r, RelMseOptions::default()).ok());
+                let error = reference.and_then(|r| {
+                    let comparable = self.image.at_size(r.width, r.height)?;
+                    rel_mse(&comparable, r, RelMseOptions::default()).ok()
+                });
                 self.history.push(PassRecord {
                     passes: stats.passes,
                     seconds: stats.elapsed.as_secs_f64(),

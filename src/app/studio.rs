@@ -350,8 +350,8 @@ impl StudioApp {
         });
     }
 
-    /// The preset's stored reference, used for the panes' error when its
-    /// size matches theirs.
+    /// The preset's stored reference, used for the panes' error when their
+    /// size is a whole multiple of it.
     fn load_reference(&mut self) {
         self.reference = None;
         let Some(name) =

@@ -11,6 +11,7 @@ use super::render::map_line;
 use super::RenderFlags;
 use crate::photon::file::{save_photon_maps, settings_key};
 use crate::photon::PhotonMaps;
+use crate::render::camera::CameraModel;
 use crate::render::world::World;
 use crate::scene::load_scene;
 
@@ -30,9 +31,14 @@ pub fn run(args: &PhotonsArgs) -> Result<()> {
     let settings = args.flags.settings(&scene)?;
     let bar = ProgressBar::new_spinner().with_message("tracing photons");
     bar.enable_steady_tick(Duration::from_millis(120));
-    let world = World::new(&scene);
+    let mut world = World::new(&scene);
+    let camera = CameraModel::new(&scene.camera, settings.width, settings.height);
+    let visible = world.visible_points(&camera, settings.width, settings.height);
+    world.cover(&visible);
+    let visible_radius = World::visible_radius(&visible).unwrap_or(world.bounds_radius.max(1.0));
     let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build()?;
-    let maps = pool.install(|| PhotonMaps::build(&world, &settings.photon, settings.seed, settings.max_depth));
+    let maps =
+        pool.install(|| PhotonMaps::build(&world, &settings.photon, settings.seed, settings.max_depth, visible_radius));
     bar.finish_and_clear();
     let key = settings_key(&settings.photon, settings.seed, settings.max_depth);
     save_photon_maps(&maps, scene.content_key(), key, &args.output)?;

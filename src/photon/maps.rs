@@ -72,17 +72,18 @@ pub struct PhotonMaps {
 }
 
 /// The gather radius when the settings leave it to the scene: a few percent
-/// of the finite geometry's size.
-pub fn resolve_max_radius(world: &World, settings: &PhotonSettings) -> f32 {
+/// of the size of what the camera sees (`World::visible_radius`).
+pub fn resolve_max_radius(visible_radius: f32, settings: &PhotonSettings) -> f32 {
     if settings.max_radius > 0.0 {
         settings.max_radius
     } else {
-        (world.bounds_radius * 0.05).max(1e-4)
+        (visible_radius * 0.05).max(1e-6)
     }
 }
 
 impl PhotonMaps {
-    pub fn build(world: &World, settings: &PhotonSettings, seed: u64, max_depth: u32) -> Self {
+    /// Trace both maps; `visible_radius` sets the default gather radius.
+    pub fn build(world: &World, settings: &PhotonSettings, seed: u64, max_depth: u32, visible_radius: f32) -> Self {
         let build = |kind: MapKind, count: u32| -> (PhotonKdTree, MapStats) {
             let start = Instant::now();
             let photons = trace_photons(world, kind, count as u64, 0, seed, max_depth);
@@ -105,7 +106,7 @@ impl PhotonMaps {
             global,
             caustic,
             stats: PhotonMapStats { global: global_stats, caustic: caustic_stats },
-            max_radius: resolve_max_radius(world, settings),
+            max_radius: resolve_max_radius(visible_radius, settings),
         }
     }
 }

@@ -276,14 +276,24 @@ fn run_job(context: &JobContext, job: &RenderJob) {
         context.send(RenderEvent::Failed { generation, message: "image size must be at least 1×1".into() });
         return;
     }
-    let world = World::new(&job.scene);
+    let mut world = World::new(&job.scene);
+    let camera = CameraModel::new(&job.scene.camera, settings.width, settings.height);
+    let visible = world.visible_points(&camera, settings.width, settings.height);
+    world.cover(&visible);
+    let visible_radius = World::visible_radius(&visible).unwrap_or(world.bounds_radius.max(1.0));
     let start = Instant::now();
     let method = match settings.algorithm {
         Algorithm::Whitted | Algorithm::Path => Method::Sample,
         Algorithm::Photon => {
             let maps = match &job.photon_maps {
                 Some(maps) => maps.clone(),
-                None => Arc::new(PhotonMaps::build(&world, &settings.photon, settings.seed, settings.max_depth)),
+                None => Arc::new(PhotonMaps::build(
+                    &world,
+                    &settings.photon,
+                    settings.seed,
+                    settings.max_depth,
+                    visible_radius,
+                )),
             };
             if !context.is_current() {
                 return;
@@ -294,11 +304,11 @@ fn run_job(context: &JobContext, job: &RenderJob) {
         Algorithm::Sppm => Method::Sppm,
     };
     let frame = FrameContext {
-        camera: CameraModel::new(&job.scene.camera, settings.width, settings.height),
+        camera,
         sppm_initial_radius: if settings.photon.sppm_initial_radius > 0.0 {
             settings.photon.sppm_initial_radius
         } else {
-            (world.bounds_radius * 0.02).max(1e-4)
+            (visible_radius * 0.02).max(1e-6)
         },
         world,
         method,

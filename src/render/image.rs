@@ -75,6 +75,40 @@ impl LinearImage {
         sum.map(|s| s / n)
     }
 
+    /// Box-filter down by an integer factor: each output pixel averages a
+    /// factor × factor block, which is exactly what a render at the smaller
+    /// size estimates (pixels integrate over their area).
+    pub fn downsample(&self, factor: u32) -> LinearImage {
+        let factor = factor.max(1);
+        let (width, height) = (self.width / factor, self.height / factor);
+        let mut out = LinearImage::new(width, height);
+        let weight = 1.0 / (factor * factor) as f64;
+        for y in 0..height {
+            for x in 0..width {
+                let mut sum = [0.0f64; 3];
+                for dy in 0..factor {
+                    for dx in 0..factor {
+                        let p = self.get(x * factor + dx, y * factor + dy);
+                        (0..3).for_each(|c| sum[c] += p[c] as f64);
+                    }
+                }
+                out.pixels[(y * width + x) as usize] = sum.map(|s| (s * weight) as f32);
+            }
+        }
+        out
+    }
+
+    /// This image at `width × height` if that divides it evenly (itself when
+    /// the size already matches).
+    pub fn at_size(&self, width: u32, height: u32) -> Option<std::borrow::Cow<'_, LinearImage>> {
+        if (self.width, self.height) == (width, height) {
+            return Some(std::borrow::Cow::Borrowed(self));
+        }
+        let factor = self.width / width.max(1);
+        (factor > 1 && width * factor == self.width && height * factor == self.height)
+            .then(|| std::borrow::Cow::Owned(self.downsample(factor)))
+    }
+
     /// `.png`: tone-mapped sRGB 8-bit; `.exr`: linear 32-bit float.
     pub fn save(&self, path: &Path, exposure_stops: f32) -> Result<(), ImageError> {
         let name = path.display().to_string();
@@ -132,6 +166,17 @@ mod tests {
         assert_eq!(tonemap_srgb8([0.0, 1.0, 0.5], 0.0), [0, 255, 188]);
         assert_eq!(tonemap_srgb8([0.25, 2.0, f32::NAN], 1.0), [188, 255, 0]);
         assert_eq!(tonemap_srgb8([-1.0, f32::INFINITY, 0.0], 0.0), [0, 0, 0]);
+    }
+
+    #[test]
+    fn downsampling_averages_blocks() {
+        let mut img = LinearImage::new(4, 2);
+        img.pixels[0] = [4.0, 0.0, 0.0];
+        img.pixels[5] = [0.0, 8.0, 0.0];
+        let small = img.at_size(2, 1).unwrap();
+        assert_eq!(small.pixels, vec![[1.0, 2.0, 0.0], [0.0; 3]]);
+        assert!(img.at_size(3, 1).is_none());
+        assert!(matches!(img.at_size(4, 2), Some(std::borrow::Cow::Borrowed(_))));
     }
 
     #[test]

@@ -4,6 +4,7 @@
 
 use glam::Vec3;
 
+use super::camera::CameraModel;
 use super::light::LightSource;
 use super::spheres::SphereLanes;
 use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
@@ -69,8 +70,8 @@ pub struct World {
     pub lights: Vec<LightSource>,
     pub background: Rgb,
     pub ambient: Rgb,
-    /// A sphere around everything finite (planes excluded), for emitting
-    /// photons from directional lights.
+    /// Where photons must go: a sphere around everything finite (planes
+    /// excluded), or around what the camera sees once `cover` was called.
     pub bounds_center: Vec3,
     pub bounds_radius: f32,
 }
@@ -212,6 +213,49 @@ impl World {
         self.spheres.lanes.any_hit(ray, t_max)
             || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
             || self.triangles.iter().any(|(t, _)| intersect_triangle(ray, t, t_max).is_some())
+    }
+
+    /// First hits of a grid of primary rays: where the camera looks.
+    pub fn visible_points(&self, camera: &CameraModel, width: u32, height: u32) -> Vec<Vec3> {
+        const GRID: u32 = 16;
+        (0..GRID * GRID)
+            .filter_map(|k| {
+                let x = ((k % GRID) as f32 + 0.5) / GRID as f32 * width as f32;
+                let y = ((k / GRID) as f32 + 0.5) / GRID as f32 * height as f32;
+                self.intersect(&camera.pixel_ray(x, y), f32::INFINITY).map(|hit| hit.surface.point)
+            })
+            .filter(|p| p.is_finite())
+            .collect()
+    }
+
+    /// The size of what the camera sees: the root-mean-square spread of
+    /// `visible_points`. Gather radii are fractions of it; the bounds of all
+    /// geometry would not do, since smallpt's walls are spheres of radius 1e5
+    /// around a room of 100.
+    pub fn visible_radius(points: &[Vec3]) -> Option<f32> {
+        if points.len() < 2 {
+            return None;
+        }
+        let mean = points.iter().copied().sum::<Vec3>() / points.len() as f32;
+        let rms = (points.iter().map(|p| (*p - mean).length_squared()).sum::<f32>() / points.len() as f32).sqrt();
+        (rms.is_finite() && rms > 0.0).then_some(rms)
+    }
+
+    /// Make the photon-emission region (the directional lights' disc, and
+    /// the part of giant emitters photons leave from) the bounding sphere of
+    /// the visible points, with a margin for light that bounces in from just
+    /// outside the view. The bounds of all finite objects would not do when
+    /// walls are spheres of radius 1e5.
+    pub fn cover(&mut self, points: &[Vec3]) {
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for p in points {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        if lo.x <= hi.x {
+            self.bounds_center = (lo + hi) * 0.5;
+            self.bounds_radius = (hi - lo).length() * 0.75;
+        }
     }
 
     #[inline]
