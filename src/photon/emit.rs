@@ -32,29 +32,11 @@ pub fn light_power(world: &World, light: &LightSource) -> Rgb {
     }
 }
 
-/// The part of an emissive sphere photons leave from: (axis, 1 − cos θ of
-/// the cap). Normally the whole sphere; a sphere larger than the region the
-/// photons must reach (smallpt's light of radius 600 over a room of 100,
-/// whose cap inside the room is 2·10⁻⁴ of its area) emits only from the cap
-/// within that region, or almost no photon would enter the scene.
-fn emitting_cap(world: &World, center: Vec3, radius: f32) -> (Vec3, f32) {
-    let (region, extent) = (world.bounds_center, world.bounds_radius);
-    let to_region = region - center;
-    let distance = to_region.length();
-    if radius <= extent || distance <= 0.0 || distance >= radius + extent || distance + radius <= extent {
-        return (Vec3::Z, 2.0);
-    }
-    // |p − region|² ≤ extent² on the sphere ⇔ cos θ ≥ (r² + d² − R²)/(2 r d)
-    let cos_min =
-        ((radius * radius + distance * distance - extent * extent) / (2.0 * radius * distance)).clamp(-1.0, 1.0);
-    (to_region / distance, 1.0 - cos_min)
-}
-
 fn emitter_area(world: &World, object: u32) -> f32 {
     match world.objects[object as usize].shape {
         ShapeRef::Sphere(i) => {
             let (center, radius) = (world.spheres.center(i as usize), world.spheres.radius[i as usize]);
-            2.0 * PI * radius * radius * emitting_cap(world, center, radius).1
+            2.0 * PI * radius * radius * world.emitting_cap(center, radius).1
         }
         ShapeRef::Triangle(t) => world.triangles[t as usize].0.area(),
         ShapeRef::Plane(_) => 0.0,
@@ -145,7 +127,7 @@ fn point_on_emitter(world: &World, object: u32, u: Vec2) -> Option<(Vec3, Vec3, 
         ShapeRef::Sphere(i) => {
             let (center, radius) = (world.spheres.center(i as usize), world.spheres.radius[i as usize]);
             // Uniform over the emitting cap (the whole sphere when 1 − cos = 2)
-            let (axis, one_minus_cos) = emitting_cap(world, center, radius);
+            let (axis, one_minus_cos) = world.emitting_cap(center, radius);
             let normal = if one_minus_cos >= 2.0 {
                 uniform_sphere(u)
             } else {

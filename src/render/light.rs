@@ -120,6 +120,21 @@ fn sample_area(world: &World, object: u32, p: Vec3, u: Vec2) -> Option<(Vec3, Ve
         ShapeRef::Sphere(i) => {
             let i = i as usize;
             let (center, radius) = (world.spheres.center(i), world.spheres.radius[i]);
+            let (axis, cap) = world.emitting_cap(center, radius);
+            if cap < 2.0 {
+                // A giant light: uniform over its cap in the scene
+                let normal = Frame::from_z(axis).to_world(uniform_cone(u, cap));
+                let point = center + normal * radius;
+                let to_light = point - p;
+                let distance2 = to_light.length_squared();
+                let cos_light = normal.dot(-to_light) / distance2.sqrt();
+                if cos_light <= 0.0 {
+                    return None;
+                }
+                let error = crate::geometry::gamma(6) * (center.abs().max_element() + radius);
+                let area = 2.0 * std::f32::consts::PI * radius * radius * cap;
+                return Some((point, normal, error, distance2 / (cos_light * area)));
+            }
             let to_center = center - p;
             let distance2 = to_center.length_squared();
             let sin2_max = radius * radius / distance2;
@@ -171,8 +186,21 @@ pub fn area_pdf(world: &World, object: u32, p: Vec3, hit: &SurfaceHit) -> f32 {
     match world.objects[object as usize].shape {
         ShapeRef::Sphere(i) => {
             let i = i as usize;
-            let radius = world.spheres.radius[i];
-            let distance2 = (world.spheres.center(i) - p).length_squared();
+            let (center, radius) = (world.spheres.center(i), world.spheres.radius[i]);
+            let (axis, cap) = world.emitting_cap(center, radius);
+            if cap < 2.0 {
+                // Light sampling reaches only the cap: elsewhere its pdf is 0
+                let normal = (hit.point - center) / radius;
+                if normal.dot(axis) < 1.0 - cap {
+                    return 0.0;
+                }
+                let to_light = hit.point - p;
+                let distance2 = to_light.length_squared();
+                let cos_light = normal.dot(-to_light).abs() / distance2.sqrt();
+                let area = 2.0 * std::f32::consts::PI * radius * radius * cap;
+                return if cos_light > 0.0 { distance2 / (cos_light * area) } else { 0.0 };
+            }
+            let distance2 = (center - p).length_squared();
             let sin2_max = radius * radius / distance2;
             if sin2_max >= 1.0 {
                 return 0.0;

@@ -258,6 +258,27 @@ impl World {
         }
     }
 
+    /// The part of an emissive sphere that lights the scene: (axis, 1 − cos θ
+    /// of the cap), 1 − cos θ = 2 for the whole sphere. A sphere larger than
+    /// the region the camera sees (smallpt's light of radius 600 over a room
+    /// of 100, whose cap inside the room is 2·10⁻⁴ of its area) is sampled
+    /// only on its cap within that region: photons leave from there, and
+    /// light sampling aims there (unbiased with MIS, which leaves the rest of
+    /// the sphere to BSDF sampling).
+    #[inline]
+    pub fn emitting_cap(&self, center: Vec3, radius: f32) -> (Vec3, f32) {
+        let (region, extent) = (self.bounds_center, self.bounds_radius);
+        let to_region = region - center;
+        let distance = to_region.length();
+        if radius <= extent || distance <= 0.0 || distance >= radius + extent || distance + radius <= extent {
+            return (Vec3::Z, 2.0);
+        }
+        // |p − region|² ≤ extent² on the sphere ⇔ cos θ ≥ (r² + d² − R²)/(2 r d)
+        let cos_min =
+            ((radius * radius + distance * distance - extent * extent) / (2.0 * radius * distance)).clamp(-1.0, 1.0);
+        (to_region / distance, 1.0 - cos_min)
+    }
+
     #[inline]
     pub fn material_of(&self, hit: &Hit) -> &MaterialModel {
         &self.materials[hit.material as usize]
