@@ -74,6 +74,19 @@ fn photon_mapping_agrees_with_converged_path_tracing_on_a_diffuse_scene() {
 }
 
 #[test]
+fn final_gathering_agrees_with_converged_path_tracing_too() {
+    let scene = diffuse_cornell();
+    let reference = render(&scene, settings(Algorithm::Path, 40, 30, 2048));
+    let mut photon = settings(Algorithm::Photon, 40, 30, 16);
+    photon.photon.global_photons = 200_000;
+    photon.photon.final_gather = true;
+    photon.photon.final_gather_rays = 16;
+    let image = render(&scene, photon);
+    let error = rel_mse(&image, &reference, RelMseOptions::default()).unwrap();
+    assert!(error < 0.02, "relMSE {error}");
+}
+
+#[test]
 fn sppm_error_keeps_falling() {
     let scene = presets::preset("caustics").unwrap().unwrap();
     let reference = render(&scene, settings(Algorithm::Path, 40, 30, 4096));

@@ -94,10 +94,7 @@ impl PhotonRenderer<'_> {
         let world = self.world;
         let n = hit.surface.normal;
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
-        let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
-        let mut radiance = direct_light(world, hit, wo, facing, bsdf, sampler, counters);
-        radiance +=
-            estimate(&self.maps.caustic, point, facing, wo, bsdf, k, r, &mut scratch.neighbours, &mut scratch.queries);
+        let mut radiance = self.radiance_from_maps(hit, wo, facing, bsdf, !gather, sampler, counters, scratch);
         if gather {
             let rays = self.settings.final_gather_rays.max(1);
             let mut sum = Rgb::ZERO;
@@ -109,17 +106,6 @@ impl PhotonRenderer<'_> {
             }
             radiance += sum / rays as f32;
         } else {
-            radiance += estimate(
-                &self.maps.global,
-                point,
-                facing,
-                wo,
-                bsdf,
-                k,
-                r,
-                &mut scratch.neighbours,
-                &mut scratch.queries,
-            );
             // Photons come only from lights: the background reaches the
             // surface through one BSDF-sampled ray
             if world.background != Rgb::ZERO {
@@ -156,31 +142,7 @@ impl PhotonRenderer<'_> {
             if !bsdf.is_specular() {
                 let n = hit.surface.normal;
                 let facing = if wo.dot(n) < 0.0 { -n } else { n };
-                let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
-                let mut radiance = direct_light(world, &hit, wo, facing, &bsdf, sampler, counters);
-                radiance += estimate(
-                    &self.maps.caustic,
-                    point,
-                    facing,
-                    wo,
-                    &bsdf,
-                    k,
-                    r,
-                    &mut scratch.neighbours,
-                    &mut scratch.queries,
-                );
-                radiance += estimate(
-                    &self.maps.global,
-                    point,
-                    facing,
-                    wo,
-                    &bsdf,
-                    k,
-                    r,
-                    &mut scratch.neighbours,
-                    &mut scratch.queries,
-                );
-                return throughput * radiance;
+                return throughput * self.radiance_from_maps(&hit, wo, facing, &bsdf, true, sampler, counters, scratch);
             }
             let Some(s) =
                 bsdf.sample(wo, hit.surface.normal, sampler.next_f32(), sampler.next_2d(), Transport::Radiance)
@@ -191,6 +153,42 @@ impl PhotonRenderer<'_> {
             ray = hit.surface.spawn_ray(s.wi);
         }
         Rgb::ZERO
+    }
+}
+
+impl PhotonRenderer<'_> {
+    /// Direct light by shadow rays, caustics from the caustic map and, if
+    /// asked, indirect light from the global map.
+    #[allow(clippy::too_many_arguments)]
+    fn radiance_from_maps(
+        &self,
+        hit: &Hit,
+        wo: Vec3,
+        facing: Vec3,
+        bsdf: &Bsdf,
+        global: bool,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        scratch: &mut PhotonScratch,
+    ) -> Rgb {
+        let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
+        let mut radiance = direct_light(self.world, hit, wo, facing, bsdf, sampler, counters);
+        radiance +=
+            estimate(&self.maps.caustic, point, facing, wo, bsdf, k, r, &mut scratch.neighbours, &mut scratch.queries);
+        if global {
+            radiance += estimate(
+                &self.maps.global,
+                point,
+                facing,
+                wo,
+                bsdf,
+                k,
+                r,
+                &mut scratch.neighbours,
+                &mut scratch.queries,
+            );
+        }
+        radiance
     }
 }
 

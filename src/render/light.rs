@@ -125,15 +125,10 @@ fn sample_area(world: &World, object: u32, p: Vec3, u: Vec2) -> Option<(Vec3, Ve
                 // A giant light: uniform over its cap in the scene
                 let normal = Frame::from_z(axis).to_world(uniform_cone(u, cap));
                 let point = center + normal * radius;
-                let to_light = point - p;
-                let distance2 = to_light.length_squared();
-                let cos_light = normal.dot(-to_light) / distance2.sqrt();
-                if cos_light <= 0.0 {
-                    return None;
-                }
                 let error = crate::geometry::gamma(6) * (center.abs().max_element() + radius);
                 let area = 2.0 * std::f32::consts::PI * radius * radius * cap;
-                return Some((point, normal, error, distance2 / (cos_light * area)));
+                let pdf = solid_angle_pdf(p, point, normal, area);
+                return (pdf > 0.0).then_some((point, normal, error, pdf));
             }
             let to_center = center - p;
             let distance2 = to_center.length_squared();
@@ -166,16 +161,25 @@ fn sample_area(world: &World, object: u32, p: Vec3, u: Vec2) -> Option<(Vec3, Ve
             let (b0, b1) = uniform_triangle(u);
             let [a, b, c] = triangle.vertices;
             let point = a * b0 + b * b1 + c * (1.0 - b0 - b1);
-            let to_light = point - p;
-            let distance2 = to_light.length_squared();
-            let cos_light = triangle.normal.dot(-to_light) / distance2.sqrt();
-            if cos_light <= 0.0 {
-                return None;
-            }
             let error = crate::geometry::gamma(7) * (a.abs() + b.abs() + c.abs()).max_element();
-            Some((point, triangle.normal, error, distance2 / (cos_light * triangle.area())))
+            let pdf = solid_angle_pdf(p, point, triangle.normal, triangle.area());
+            (pdf > 0.0).then_some((point, triangle.normal, error, pdf))
         }
         ShapeRef::Plane(_) => None,
+    }
+}
+
+/// A uniform-area pdf 1/area turned into solid angle at `p`: d²/(cos θ·A),
+/// 0 when the light's front faces away.
+#[inline]
+fn solid_angle_pdf(p: Vec3, point: Vec3, normal: Vec3, area: f32) -> f32 {
+    let to_light = point - p;
+    let distance2 = to_light.length_squared();
+    let cos_light = normal.dot(-to_light) / distance2.sqrt();
+    if cos_light > 0.0 {
+        distance2 / (cos_light * area)
+    } else {
+        0.0
     }
 }
 
@@ -194,11 +198,7 @@ pub fn area_pdf(world: &World, object: u32, p: Vec3, hit: &SurfaceHit) -> f32 {
                 if normal.dot(axis) < 1.0 - cap {
                     return 0.0;
                 }
-                let to_light = hit.point - p;
-                let distance2 = to_light.length_squared();
-                let cos_light = normal.dot(-to_light).abs() / distance2.sqrt();
-                let area = 2.0 * std::f32::consts::PI * radius * radius * cap;
-                return if cos_light > 0.0 { distance2 / (cos_light * area) } else { 0.0 };
+                return solid_angle_pdf(p, hit.point, normal, 2.0 * std::f32::consts::PI * radius * radius * cap);
             }
             let distance2 = (center - p).length_squared();
             let sin2_max = radius * radius / distance2;
@@ -209,13 +209,7 @@ pub fn area_pdf(world: &World, object: u32, p: Vec3, hit: &SurfaceHit) -> f32 {
         }
         ShapeRef::Triangle(t) => {
             let triangle = &world.triangles[t as usize].0;
-            let to_light = hit.point - p;
-            let distance2 = to_light.length_squared();
-            let cos_light = triangle.normal.dot(-to_light).abs() / distance2.sqrt();
-            if cos_light <= 0.0 {
-                return 0.0;
-            }
-            distance2 / (cos_light * triangle.area())
+            solid_angle_pdf(p, hit.point, triangle.normal, triangle.area())
         }
         ShapeRef::Plane(_) => 0.0,
     }
