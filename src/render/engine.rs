@@ -592,8 +592,8 @@ impl FrameContext<'_> {
     }
 }
 
-/// Render a job to completion on the calling thread's pool, for tests and
-/// tools that want just the image. `events` receives progress if given.
+/// Render a job to completion on its own session, for tests and tools that
+/// want just the image (and the final statistics).
 pub fn render_blocking(job: &RenderJob) -> Result<(LinearImage, PassStats), String> {
     let session = RenderSession::new(None);
     let generation = session.start(job.clone());

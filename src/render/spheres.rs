@@ -42,21 +42,20 @@ impl SphereLanes {
         self.count == 0
     }
 
-    /// For one group: the nearest root in (0, t_max) per lane (infinity where
-    /// none) and whether it is the near root.
+    /// Per lane of one group: the nearest root in (0, t_max), infinity where
+    /// there is none, and whether it is the near root.
     #[inline(always)]
-    fn group(&self, g: usize, ray: &Ray, t_max: Vec4) -> (Vec4, BVec4A) {
+    fn group(cx: Vec4, cy: Vec4, cz: Vec4, r2: Vec4, ray: &Ray, t_max: Vec4) -> (Vec4, BVec4A) {
         let (o, d) = (ray.origin, ray.direction);
-        let fx = Vec4::splat(o.x) - self.center_x[g];
-        let fy = Vec4::splat(o.y) - self.center_y[g];
-        let fz = Vec4::splat(o.z) - self.center_z[g];
+        let fx = Vec4::splat(o.x) - cx;
+        let fy = Vec4::splat(o.y) - cy;
+        let fz = Vec4::splat(o.z) - cz;
         let (dx, dy, dz) = (Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z));
         let b = fx * dx + fy * dy + fz * dz;
         // Discriminant from the closest approach (Ray Tracing Gems ch. 7)
         let lx = fx - b * dx;
         let ly = fy - b * dy;
         let lz = fz - b * dz;
-        let r2 = self.radius2[g];
         let discriminant = r2 - (lx * lx + ly * ly + lz * lz);
         let c = fx * fx + fy * fy + fz * fz - r2;
         let q = -b - discriminant.max(Vec4::ZERO).sqrt().copysign(b);
@@ -69,22 +68,30 @@ impl SphereLanes {
         (t, near_ok)
     }
 
+    /// The groups' lanes side by side (zipped: no bounds checks in the loop).
+    #[inline(always)]
+    fn groups(&self) -> impl Iterator<Item = (Vec4, Vec4, Vec4, Vec4)> + '_ {
+        self.center_x
+            .iter()
+            .zip(&self.center_y)
+            .zip(&self.center_z)
+            .zip(&self.radius2)
+            .map(|(((x, y), z), r)| (*x, *y, *z, *r))
+    }
+
     /// Nearest hit in (0, t_max): (sphere index, t, near root).
     #[inline]
     pub fn nearest(&self, ray: &Ray, t_max: f32) -> Option<(usize, f32, bool)> {
         let mut best = t_max;
         let mut found = None;
-        for g in 0..self.radius2.len() {
-            let (t, near) = self.group(g, ray, Vec4::splat(best));
-            if t.cmplt(Vec4::splat(best)).any() {
-                let lanes = t.to_array();
-                let near = near.bitmask();
-                for (k, tk) in lanes.into_iter().enumerate() {
-                    if tk < best {
-                        best = tk;
-                        found = Some((g * 4 + k, tk, near & (1 << k) != 0));
-                    }
-                }
+        for (g, (cx, cy, cz, r2)) in self.groups().enumerate() {
+            let (t, near) = Self::group(cx, cy, cz, r2, ray, Vec4::splat(best));
+            let closest = t.min_element();
+            if closest < best {
+                // The lane holding the minimum, without a loop over lanes
+                let lane = t.cmpeq(Vec4::splat(closest)).bitmask().trailing_zeros() as usize;
+                best = closest;
+                found = Some((g * 4 + lane, closest, near.bitmask() & (1 << lane) != 0));
             }
         }
         found
@@ -94,7 +101,7 @@ impl SphereLanes {
     #[inline]
     pub fn any_hit(&self, ray: &Ray, t_max: f32) -> bool {
         let limit = Vec4::splat(t_max);
-        (0..self.radius2.len()).any(|g| self.group(g, ray, limit).0.cmplt(limit).any())
+        self.groups().any(|(cx, cy, cz, r2)| Self::group(cx, cy, cz, r2, ray, limit).0.cmplt(limit).any())
     }
 }
 
