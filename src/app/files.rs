@@ -11,6 +11,8 @@ pub enum DialogPurpose {
     SaveScene,
     ExportPng,
     ExportExr,
+    Screenshot,
+    ComparisonSheet,
 }
 
 impl DialogPurpose {
@@ -20,6 +22,8 @@ impl DialogPurpose {
             DialogPurpose::SaveScene => "Save scene as",
             DialogPurpose::ExportPng => "Export image (PNG)",
             DialogPurpose::ExportExr => "Export image (EXR, linear)",
+            DialogPurpose::Screenshot => "Save window screenshot (PNG)",
+            DialogPurpose::ComparisonSheet => "Export comparison sheet (PNG)",
         }
     }
 }

@@ -50,12 +50,12 @@ pub fn menu_bar_ui(ui: &mut egui::Ui, app: &mut StudioApp) {
                     ui.close();
                 }
             });
-            if ui.button("Save window screenshot").clicked() {
-                app.take_screenshot(None);
+            if ui.button("Save window screenshot…").clicked() {
+                app.open_dialog(DialogPurpose::Screenshot);
                 ui.close();
             }
-            if ui.button("Export comparison sheet").clicked() {
-                app.take_screenshot(Some(app.panes_rect));
+            if ui.button("Export comparison sheet…").clicked() {
+                app.open_dialog(DialogPurpose::ComparisonSheet);
                 ui.close();
             }
             ui.separator();

@@ -55,6 +55,8 @@ struct ScreenshotRequest {
     /// Wait until every pane has this many passes (the --screenshot mode).
     after_passes: Option<u32>,
     quit_after: bool,
+    /// Frames to wait first, so the dialog that asked for it is gone.
+    delay: u8,
     requested: bool,
     result: Arc<Mutex<Option<Result<(), String>>>>,
 }
@@ -161,6 +163,7 @@ impl StudioApp {
                 crop: None,
                 after_passes: Some(args.quit_after_passes.max(1)),
                 quit_after: true,
+                delay: 0,
                 requested: false,
                 result: Arc::new(Mutex::new(None)),
             });
@@ -333,18 +336,21 @@ impl StudioApp {
             }
             DialogPurpose::ExportPng => PathBuf::from("render.png"),
             DialogPurpose::ExportExr => PathBuf::from("render.exr"),
+            DialogPurpose::Screenshot => PathBuf::from("screenshot.png"),
+            DialogPurpose::ComparisonSheet => PathBuf::from("comparison.png"),
         };
         self.dialog = Some(FileDialog::new(purpose, &suggestion));
     }
 
-    /// Save the window (or the panes' area) as PNG at the next frame.
-    pub fn take_screenshot(&mut self, crop: Option<egui::Rect>) {
-        let name = if crop.is_some() { "comparison.png" } else { "screenshot.png" };
+    /// Save the window (or, for the comparison sheet, the panes' area with
+    /// their labels) as PNG at the next frame.
+    pub fn take_screenshot(&mut self, path: PathBuf, crop: Option<egui::Rect>) {
         self.screenshot = Some(ScreenshotRequest {
-            path: PathBuf::from(name),
+            path,
             crop,
             after_passes: None,
             quit_after: false,
+            delay: 2,
             requested: false,
             result: Arc::new(Mutex::new(None)),
         });
@@ -541,6 +547,8 @@ impl StudioApp {
                     DialogPurpose::OpenScene => self.request(Action::Open(path)),
                     DialogPurpose::SaveScene => self.save_to(&path),
                     DialogPurpose::ExportPng | DialogPurpose::ExportExr => self.export_pane(0, &path),
+                    DialogPurpose::Screenshot => self.take_screenshot(path, None),
+                    DialogPurpose::ComparisonSheet => self.take_screenshot(path, Some(self.panes_rect)),
                 }
             }
         }
@@ -617,6 +625,11 @@ impl StudioApp {
     fn screenshot_step(&mut self, ctx: &egui::Context) {
         let Some(shot) = &mut self.screenshot else { return };
         if !shot.requested {
+            if shot.delay > 0 {
+                shot.delay -= 1;
+                ctx.request_repaint();
+                return;
+            }
             let ready = match shot.after_passes {
                 Some(n) => {
                     self.panes.iter().all(|p| p.state.passes() >= n || p.state.finished || p.state.failed.is_some())
@@ -756,5 +769,33 @@ impl eframe::App for StudioApp {
 
     fn auto_save_interval(&self) -> std::time::Duration {
         std::time::Duration::from_secs(10)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn comparison_sheet_is_the_cropped_region_in_physical_pixels() {
+        let (w, h) = (20usize, 16usize);
+        let pixels: Vec<egui::Color32> =
+            (0..w * h).map(|i| egui::Color32::from_rgb((i % w) as u8, (i / w) as u8, 7)).collect();
+        let image = egui::ColorImage { size: [w, h], pixels, source_size: egui::vec2(w as f32, h as f32) };
+        let path = std::env::temp_dir().join(format!("gi-sheet-{}.png", std::process::id()));
+        // Points at 2 pixels per point: the rect (1, 2)–(5, 5) is pixels (2, 4)–(10, 10)
+        let rect = egui::Rect::from_min_max(egui::pos2(1.0, 2.0), egui::pos2(5.0, 5.0));
+        save_screenshot(&image, Some(rect), 2.0, &path).unwrap();
+        let saved = image::open(&path).unwrap().to_rgba8();
+        assert_eq!(saved.dimensions(), (8, 6));
+        assert_eq!(saved.get_pixel(0, 0).0, [2, 4, 7, 255]);
+        assert_eq!(saved.get_pixel(7, 5).0, [9, 9, 7, 255]);
+        assert!(save_screenshot(
+            &image,
+            Some(egui::Rect::from_min_max(egui::pos2(30.0, 30.0), egui::pos2(40.0, 40.0))),
+            1.0,
+            &path
+        )
+        .is_err());
     }
 }
