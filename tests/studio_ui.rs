@@ -179,3 +179,60 @@ fn every_menu_opens_and_draws() {
         harness.run_steps(2);
     }
 }
+
+#[test]
+fn rendering_pauses_while_minimised_and_resumes_after() {
+    let mut harness = studio(1);
+    step_until(&mut harness, |app| app.panes[0].state.passes() >= 1);
+    let minimise = |harness: &mut Harness<'static, StudioApp>, minimised: bool| {
+        harness.input_mut().viewports.entry(egui::ViewportId::ROOT).or_default().minimized = Some(minimised);
+        harness.run_steps(2);
+    };
+    minimise(&mut harness, true);
+    assert!(harness.state().is_paused());
+    let generation = harness.state().generations()[0];
+    minimise(&mut harness, false);
+    assert!(!harness.state().is_paused());
+    assert!(harness.state().generations()[0] > generation, "restored: the panes render again");
+}
+
+/// eframe storage in memory, as a second start would read it.
+#[derive(Default)]
+struct MemoryStorage(std::collections::HashMap<String, String>);
+
+impl eframe::Storage for MemoryStorage {
+    fn get_string(&self, key: &str) -> Option<String> {
+        self.0.get(key).cloned()
+    }
+    fn set_string(&mut self, key: &str, value: String) {
+        self.0.insert(key.to_owned(), value);
+    }
+    fn remove_string(&mut self, key: &str) {
+        self.0.remove(key);
+    }
+    fn flush(&mut self) {}
+}
+
+#[test]
+fn layout_is_restored_and_an_unsaved_scene_is_offered_back() {
+    let mut storage = MemoryStorage::default();
+    let edited = {
+        let args = StudioArgs { panes: Some(2), ..Default::default() };
+        let mut app = StudioApp::new(&egui::Context::default(), None, &args);
+        app.scene.camera.fov_y_degrees = 55.0;
+        eframe::App::save(&mut app, &mut storage);
+        app.scene.clone()
+    };
+    // Next start: two panes again, and the edit offered back
+    let app = StudioApp::new(&egui::Context::default(), Some(&storage), &StudioArgs::default());
+    assert_eq!(app.panes.len(), 2);
+    assert!(app.offers_autosave());
+    let mut harness =
+        Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app);
+    harness.run_steps(2);
+    assert_ne!(harness.state().scene, edited);
+    harness.get_by_label("Restore").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().scene, edited);
+    assert!(!harness.state().offers_autosave());
+}

@@ -33,7 +33,7 @@ pub fn menu_bar_ui(ui: &mut egui::Ui, app: &mut StudioApp) {
                 }
             });
             if ui.add(egui::Button::new("Save").shortcut_text("Ctrl+S")).clicked() {
-                app.save();
+                app.save_or_ask();
                 ui.close();
             }
             if ui.button("Save as…").clicked() {

@@ -228,6 +228,16 @@ impl StudioApp {
         self.history.redo(&mut self.scene);
     }
 
+    /// Whether rendering is paused (the window is minimised).
+    pub fn is_paused(&self) -> bool {
+        self.paused
+    }
+
+    /// Whether the last session's unsaved scene is being offered back.
+    pub fn offers_autosave(&self) -> bool {
+        self.autosave_offer.is_some()
+    }
+
     /// The generation each pane is rendering (tests watch restarts with it).
     pub fn generations(&self) -> Vec<u64> {
         self.panes.iter().map(|p| p.state.generation).collect()
@@ -301,7 +311,7 @@ impl StudioApp {
         self.recent.truncate(8);
     }
 
-    pub fn save(&mut self) {
+    pub fn save_or_ask(&mut self) {
         match self.scene_path.clone() {
             Some(path) => self.save_to(&path),
             None => self.open_dialog(DialogPurpose::SaveScene),
@@ -410,7 +420,7 @@ impl StudioApp {
             self.undo();
         }
         if save {
-            self.save();
+            self.save_or_ask();
         }
         if open {
             self.open_dialog(DialogPurpose::OpenScene);
@@ -557,7 +567,7 @@ impl StudioApp {
                 ui.label("The scene has changes that are not saved. Discard them?");
                 ui.horizontal(|ui| {
                     if ui.button("Save").clicked() {
-                        self.save();
+                        self.save_or_ask();
                         self.pending = None;
                         if !self.is_dirty() {
                             self.perform(action.clone());
