@@ -60,3 +60,44 @@ fn broken_scene_exits_non_zero_naming_file_line_and_field_without_writing() {
     assert!(stderr.contains("\"mirror ball\".shape.radius"), "{stderr}");
     assert!(!out.exists());
 }
+
+#[test]
+fn photon_statistics_are_printed() {
+    let dir = temp_dir("photons");
+    let run = |algo: &str| {
+        let output = gi_studio()
+            .args([
+                "render",
+                "assets/scenes/caustics.ron",
+                "--algo",
+                algo,
+                "--spp",
+                "3",
+                "--width",
+                "32",
+                "--height",
+                "24",
+            ])
+            .args(["--global-photons", "5000", "--caustic-photons", "5000", "--sppm-photons", "5000", "-o"])
+            .arg(dir.join(format!("{algo}.png")))
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        String::from_utf8_lossy(&output.stdout).into_owned()
+    };
+    let photon = run("photon");
+    for needle in [
+        "global map: 5000 emitted",
+        "caustic map: 5000 emitted",
+        "tree depth",
+        "k-NN (last pass):",
+        "nodes visited",
+        "µs per query",
+        "gather radius",
+    ] {
+        assert!(photon.contains(needle), "missing {needle:?} in:\n{photon}");
+    }
+    let sppm = run("sppm");
+    assert!(sppm.contains("SPPM mean radius per pass [1: ") && sppm.contains("3: "), "{sppm}");
+    assert!(sppm.contains("traced 5000 photons"), "{sppm}");
+}

@@ -24,6 +24,8 @@ pub struct PassRecord {
     pub samples_per_second: f64,
     /// relMSE against the reference, when there is one.
     pub error: Option<f64>,
+    /// SPPM's mean gather radius after the pass.
+    pub sppm_radius: Option<f32>,
 }
 
 /// What a pane knows about its current job, fed only by engine events.
@@ -90,6 +92,7 @@ impl PaneState {
                     pass_seconds: stats.pass_time.as_secs_f64(),
                     samples_per_second: stats.samples_per_second(),
                     error,
+                    sppm_radius: (stats.photon.mean_radius > 0.0).then_some(stats.photon.mean_radius),
                 });
                 self.stats = Some(stats);
             }

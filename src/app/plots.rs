@@ -94,6 +94,30 @@ fn photon_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
             }
         }
     }
+    let radii: Vec<(usize, Vec<[f64; 2]>)> = panes
+        .iter()
+        .enumerate()
+        .map(|(i, pane)| {
+            (
+                i,
+                pane.state
+                    .history
+                    .iter()
+                    .filter_map(|r| r.sppm_radius.map(|radius| [r.passes as f64, radius as f64]))
+                    .collect::<Vec<_>>(),
+            )
+        })
+        .filter(|(_, points)| !points.is_empty())
+        .collect();
+    if !radii.is_empty() {
+        any = true;
+        ui.small("SPPM mean radius per pass");
+        Plot::new("sppm_radius").height(height * 0.5).show(ui, |plot| {
+            for (i, points) in radii {
+                plot.line(Line::new(series_name(i, &panes[i]), points));
+            }
+        });
+    }
     if !any {
         ui.weak("Statistics appear when a pane renders with photon mapping or SPPM.");
     }

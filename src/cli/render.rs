@@ -104,12 +104,18 @@ pub fn print_photon_statistics(outcome: &RenderOutcome) {
         );
     }
     if !outcome.radii.is_empty() {
-        let first = outcome.radii[0];
-        let last = outcome.radii[outcome.radii.len() - 1];
+        // Passes 1, 2, 4, 8, … and the last: the whole curve in one line
+        let count = outcome.radii.len();
+        let shown: Vec<String> = (0..)
+            .map(|k| 1usize << k)
+            .take_while(|pass| *pass < count)
+            .chain(std::iter::once(count))
+            .map(|pass| format!("{pass}: {:.4}", outcome.radii[pass - 1]))
+            .collect();
         let photon = &outcome.stats.photon;
         println!(
-            "SPPM: mean radius {first:.4} after pass 1 → {last:.4} after pass {}; last pass traced {} photons ({} stored) in {:.0} ms",
-            outcome.radii.len(),
+            "SPPM mean radius per pass [{}]; last pass traced {} photons ({} stored) in {:.0} ms",
+            shown.join(", "),
             photon.photons_traced,
             photon.photons_stored,
             photon.trace_time.as_secs_f64() * 1e3
