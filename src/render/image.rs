@@ -122,7 +122,7 @@ impl LinearImage {
                 let data: Vec<f32> = self.pixels.iter().flatten().copied().collect();
                 match image::Rgb32FImage::from_raw(self.width, self.height, data) {
                     Some(buffer) => buffer.save(path),
-                    None => unreachable_size(),
+                    None => dimension_mismatch(),
                 }
             }
             _ => return Err(ImageError::UnknownFormat { path: name }),
@@ -150,8 +150,9 @@ fn srgb_decode(v: f32) -> f32 {
     }
 }
 
-// The buffer is built from width × height pixels above, so the size always fits.
-fn unreachable_size() -> image::ImageResult<()> {
+/// The fields are public: an image whose pixel count disagrees with its size
+/// is refused as the PNG path refuses it.
+fn dimension_mismatch() -> image::ImageResult<()> {
     Err(image::ImageError::Parameter(image::error::ParameterError::from_kind(
         image::error::ParameterErrorKind::DimensionMismatch,
     )))
