@@ -173,3 +173,71 @@ fn floor_under_a_giant_light_sphere() {
         assert!((got - expected).abs() < 0.01 * expected, "at {target}: {got} vs {expected}");
     }
 }
+
+/// A floor in a room whose ceiling is a black sphere of radius 1e4, under a
+/// light sphere of radius 600 that pokes 0.5 through it (smallpt's light
+/// pokes 0.27 through a ceiling of radius 1e5). Only the cap under the
+/// ceiling can light the room, and light sampling draws only that cap. Seen
+/// from below, the cap's outline is the rim circle where the two spheres
+/// meet, and a uniform emitter's irradiance depends only on its outline: the
+/// floor gets exactly what a disc of the rim's radius a at the rim's height h
+/// would give, at a distance s from its axis
+/// E = πL/2 · (1 − (h² + s² − a²) / √((h² + s² + a²)² − 4a²s²)).
+/// (A ceiling of radius 1e5 is placed only to ~5·10⁻³ in f32, which hides a
+/// sliver of the rim from every strategy alike: 0.5% less light here.)
+#[test]
+fn floor_under_a_light_poking_through_the_ceiling() {
+    let (ceiling, big, radius, poke) = (10.0f64, 1.0e4f64, 600.0f64, 0.5f64);
+    let wall_center = Vec3::new(0.0, (ceiling - big) as f32, 0.0);
+    let light_center = Vec3::new(0.0, (ceiling + radius - poke) as f32, 0.0);
+    let mut scene = scene(
+        camera(Vec3::new(0.0, 6.0, 6.0), Vec3::new(0.0, 0.0, 0.0)),
+        vec![
+            material("floor", lambert(0.5)),
+            material("black", lambert(0.0)),
+            material("light", MaterialModel::Emissive { radiance: Vec3::ONE }),
+        ],
+        vec![
+            object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor"),
+            object("ceiling", Shape::Sphere { center: wall_center, radius: big as f32 }, "black"),
+            object("light", Shape::Sphere { center: light_center, radius: radius as f32 }, "light"),
+        ],
+        vec![],
+    );
+    scene.camera.fov_y_degrees = 50.0;
+    // The rim: |p − c_light| = r and |p − c_wall| = R meet in the plane y = h
+    let (y_light, y_wall) = (light_center.y as f64, wall_center.y as f64);
+    let h = ((big * big - radius * radius) / (y_light - y_wall) + y_wall + y_light) * 0.5;
+    let a = (radius * radius - (h - y_light).powi(2)).sqrt();
+    let radiance_at = |s2: f64| {
+        let irradiance = std::f64::consts::PI / 2.0
+            * (1.0 - (h * h + s2 - a * a) / ((h * h + s2 + a * a).powi(2) - 4.0 * a * a * s2).sqrt());
+        0.5 / std::f64::consts::PI * irradiance
+    };
+
+    // The world samples exactly that cap: 1 − cos θ of the rim seen from the light's centre
+    let mut world = World::new(&scene);
+    let camera = gi_studio::render::camera::CameraModel::new(&scene.camera, 32, 24);
+    let points = world.visible_points(&camera, 32, 24);
+    world.cover(&points, &camera);
+    let cap = world.emitting_cap(1);
+    let expected_cap = 1.0 - (y_light - h) / radius;
+    assert!(((cap.one_minus_cos as f64) - expected_cap).abs() < 1e-3 * expected_cap, "{cap:?} vs {expected_cap}");
+    assert!(cap.frame.z.y < -0.999, "the cap faces down into the room: {cap:?}");
+
+    // 5×5 pixels around each target, each against the floor point at its centre
+    let image = render(scene, Algorithm::Path, 1024);
+    for target in [Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(-2.0, 0.0, 3.0)] {
+        let p = camera.project(target).unwrap();
+        let (mut got, mut expected) = (0.0, 0.0);
+        for y in p.y as u32 - 2..=p.y as u32 + 2 {
+            for x in p.x as u32 - 2..=p.x as u32 + 2 {
+                let ray = camera.pixel_ray(x as f32 + 0.5, y as f32 + 0.5);
+                let floor = ray.at(-ray.origin.y / ray.direction.y);
+                got += image.get(x, y)[0] as f64;
+                expected += radiance_at((floor.x as f64).powi(2) + (floor.z as f64).powi(2));
+            }
+        }
+        assert!((got - expected).abs() < 0.01 * expected, "at {target}: {} vs {}", got / 25.0, expected / 25.0);
+    }
+}

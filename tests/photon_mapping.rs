@@ -153,8 +153,9 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
     s.photon.global_photons = 20_000;
     s.photon.caustic_photons = 20_000;
     let mut world = World::new(&scene);
-    let points = world.visible_points(&CameraModel::new(&scene.camera, s.width, s.height), s.width, s.height);
-    world.cover(&points);
+    let camera = CameraModel::new(&scene.camera, s.width, s.height);
+    let points = world.visible_points(&camera, s.width, s.height);
+    world.cover(&points, &camera);
     let visible = World::visible_radius(&points).unwrap();
     let maps = PhotonMaps::build(&world, &s.photon, s.seed, s.max_depth, visible);
     let dir = std::env::temp_dir().join(format!("gi-pmap-{}", std::process::id()));
@@ -193,9 +194,9 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
 }
 
 /// smallpt's light is a sphere of radius 600 of which only a cap 0.27 deep
-/// shows below the ceiling: photons leave from the part of it within the
-/// region the camera sees. The power they carry must still be right: SPPM's
-/// image has the reference's mean brightness, and its error falls.
+/// shows below the ceiling: photons leave from that cap alone. The power
+/// they carry must still be right: SPPM's image has the reference's mean
+/// brightness, and its error falls.
 #[test]
 fn a_light_larger_than_the_scene_delivers_the_right_power() {
     let scene = presets::preset("smallpt").unwrap().unwrap();

@@ -34,7 +34,7 @@ pub fn run(args: &PhotonsArgs) -> Result<()> {
     let mut world = World::new(&scene);
     let camera = CameraModel::new(&scene.camera, settings.width, settings.height);
     let visible = world.visible_points(&camera, settings.width, settings.height);
-    world.cover(&visible);
+    world.cover(&visible, &camera);
     let visible_radius = World::visible_radius(&visible).unwrap_or(world.bounds_radius.max(1.0));
     let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build()?;
     let maps =

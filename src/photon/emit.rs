@@ -34,10 +34,7 @@ pub fn light_power(world: &World, light: &LightSource) -> Rgb {
 
 fn emitter_area(world: &World, object: u32) -> f32 {
     match world.objects[object as usize].shape {
-        ShapeRef::Sphere(i) => {
-            let (center, radius) = (world.spheres.center(i as usize), world.spheres.radius[i as usize]);
-            2.0 * PI * radius * radius * world.emitting_cap(center, radius).1
-        }
+        ShapeRef::Sphere(i) => world.emitting_cap(i as usize).area(world.spheres.radius[i as usize]),
         ShapeRef::Triangle(t) => world.triangles[t as usize].0.area(),
         ShapeRef::Plane(_) => 0.0,
     }
@@ -127,12 +124,9 @@ fn point_on_emitter(world: &World, object: u32, u: Vec2) -> Option<(Vec3, Vec3, 
         ShapeRef::Sphere(i) => {
             let (center, radius) = (world.spheres.center(i as usize), world.spheres.radius[i as usize]);
             // Uniform over the emitting cap (the whole sphere when 1 − cos = 2)
-            let (axis, one_minus_cos) = world.emitting_cap(center, radius);
-            let normal = if one_minus_cos >= 2.0 {
-                uniform_sphere(u)
-            } else {
-                Frame::from_z(axis).to_world(uniform_cone(u, one_minus_cos))
-            };
+            let cap = world.emitting_cap(i as usize);
+            let normal =
+                if cap.is_whole() { uniform_sphere(u) } else { cap.frame.to_world(uniform_cone(u, cap.one_minus_cos)) };
             Some((center + normal * radius, normal, crate::geometry::gamma(6) * (center.abs().max_element() + radius)))
         }
         ShapeRef::Triangle(t) => {

@@ -12,7 +12,8 @@ use super::record::Photon;
 use crate::render::PhotonSettings;
 
 const MAGIC: &[u8; 8] = b"GIPHOTON";
-pub const FORMAT_VERSION: u32 = 1;
+/// 2: giant emitters emit only from the cap the camera can see.
+pub const FORMAT_VERSION: u32 = 2;
 
 #[derive(Debug, thiserror::Error)]
 pub enum PhotonFileError {

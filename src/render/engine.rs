@@ -279,7 +279,7 @@ fn run_job(context: &JobContext, job: &RenderJob) {
     let mut world = World::new(&job.scene);
     let camera = CameraModel::new(&job.scene.camera, settings.width, settings.height);
     let visible = world.visible_points(&camera, settings.width, settings.height);
-    world.cover(&visible);
+    world.cover(&visible, &camera);
     let visible_radius = World::visible_radius(&visible).unwrap_or(world.bounds_radius.max(1.0));
     let start = Instant::now();
     let method = match settings.algorithm {

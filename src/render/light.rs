@@ -120,14 +120,13 @@ fn sample_area(world: &World, object: u32, p: Vec3, u: Vec2) -> Option<(Vec3, Ve
         ShapeRef::Sphere(i) => {
             let i = i as usize;
             let (center, radius) = (world.spheres.center(i), world.spheres.radius[i]);
-            let (axis, cap) = world.emitting_cap(center, radius);
-            if cap < 2.0 {
-                // A giant light: uniform over its cap in the scene
-                let normal = Frame::from_z(axis).to_world(uniform_cone(u, cap));
+            let cap = world.emitting_cap(i);
+            if !cap.is_whole() {
+                // Only part of the light can be seen: uniform over that cap
+                let normal = cap.frame.to_world(uniform_cone(u, cap.one_minus_cos));
                 let point = center + normal * radius;
                 let error = crate::geometry::gamma(6) * (center.abs().max_element() + radius);
-                let area = 2.0 * std::f32::consts::PI * radius * radius * cap;
-                let pdf = solid_angle_pdf(p, point, normal, area);
+                let pdf = solid_angle_pdf(p, point, normal, cap.area(radius));
                 return (pdf > 0.0).then_some((point, normal, error, pdf));
             }
             let to_center = center - p;
@@ -191,14 +190,14 @@ pub fn area_pdf(world: &World, object: u32, p: Vec3, hit: &SurfaceHit) -> f32 {
         ShapeRef::Sphere(i) => {
             let i = i as usize;
             let (center, radius) = (world.spheres.center(i), world.spheres.radius[i]);
-            let (axis, cap) = world.emitting_cap(center, radius);
-            if cap < 2.0 {
+            let cap = world.emitting_cap(i);
+            if !cap.is_whole() {
                 // Light sampling reaches only the cap: elsewhere its pdf is 0
                 let normal = (hit.point - center) / radius;
-                if normal.dot(axis) < 1.0 - cap {
+                if normal.dot(cap.frame.z) < 1.0 - cap.one_minus_cos {
                     return 0.0;
                 }
-                return solid_angle_pdf(p, hit.point, normal, 2.0 * std::f32::consts::PI * radius * radius * cap);
+                return solid_angle_pdf(p, hit.point, normal, cap.area(radius));
             }
             let distance2 = (center - p).length_squared();
             let sin2_max = radius * radius / distance2;
@@ -218,6 +217,35 @@ pub fn area_pdf(world: &World, object: u32, p: Vec3, hit: &SurfaceHit) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::camera::CameraModel;
+    use crate::render::rng::Sampler;
+
+    /// smallpt's light is a sphere of radius 600 poking 0.27 through the
+    /// ceiling. Light samples taken in the room land on the part under the
+    /// ceiling and reach the light; sampling the light's part near the room
+    /// instead had 98% of them blocked by the ceiling.
+    #[test]
+    fn smallpt_light_samples_land_under_the_ceiling() {
+        let scene = crate::scene::presets::preset("smallpt").and_then(Result::ok).expect("smallpt preset");
+        let mut world = World::new(&scene);
+        let camera = CameraModel::new(&scene.camera, 64, 48);
+        let points = world.visible_points(&camera, 64, 48);
+        world.cover(&points, &camera);
+        let ceiling = world.spheres.center(5).as_dvec3();
+        let mut s = Sampler::new(0, 0, 600);
+        let (mut taken, mut reached) = (0, 0);
+        for _ in 0..2000 {
+            // A point on whatever is below a random spot in the room
+            let above = Vec3::new(5.0 + 90.0 * s.next_f32(), 60.0, 10.0 + 140.0 * s.next_f32());
+            let Some(hit) = world.intersect(&Ray::new(above, -Vec3::Y), f32::INFINITY) else { continue };
+            let Some(sample) = world.lights[0].sample(&world, &hit.surface, s.next_2d()) else { continue };
+            let target = sample.shadow.at(sample.shadow_t_max).as_dvec3();
+            assert!((target - ceiling).length() < 1.0e5 + 0.05, "a sample above the ceiling: {target}");
+            taken += 1;
+            reached += !world.occluded(&sample.shadow, sample.shadow_t_max) as u32;
+        }
+        assert!(taken > 1500 && reached as f32 > 0.75 * taken as f32, "{reached} of {taken} samples reached the light");
+    }
 
     #[test]
     fn spot_cone_edge_is_where_cos_says() {

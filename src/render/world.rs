@@ -7,7 +7,7 @@ use glam::Vec3;
 use super::camera::CameraModel;
 use super::light::LightSource;
 use super::spheres::SphereLanes;
-use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
+use crate::geometry::{intersect_triangle, Frame, Ray, SurfaceHit, Triangle};
 use crate::geometry::{plane_hit, plane_t, sphere_hit};
 use crate::scene::{LightKind, MaterialModel, Rgb, Scene, Shape};
 
@@ -53,6 +53,42 @@ pub struct PlaneShape {
     pub object: u32,
 }
 
+/// The part of a sphere that can light the scene: a cap about `frame.z`
+/// (from the centre), `one_minus_cos` its 1 − cos θ: 2 for the whole sphere,
+/// 0 for none. Light sampling and photon emission use only the cap; MIS
+/// leaves the rest to BSDF sampling, so a cap that is too small loses no
+/// light, it is only noisier.
+#[derive(Clone, Copy, Debug)]
+pub struct EmitterCap {
+    pub frame: Frame,
+    pub one_minus_cos: f32,
+}
+
+impl EmitterCap {
+    pub const WHOLE: EmitterCap =
+        EmitterCap { frame: Frame { x: Vec3::X, y: Vec3::Y, z: Vec3::Z }, one_minus_cos: 2.0 };
+
+    /// The cap about `axis` with cos θ ≥ `cos_min` (computed in f64: the
+    /// walls of smallpt make it a difference of numbers near 1e10).
+    fn about(axis: Vec3, cos_min: f64) -> Self {
+        let one_minus_cos = (1.0 - cos_min).clamp(0.0, 2.0) as f32;
+        if one_minus_cos >= 2.0 {
+            return Self::WHOLE;
+        }
+        EmitterCap { frame: Frame::from_z(axis), one_minus_cos }
+    }
+
+    pub fn is_whole(&self) -> bool {
+        self.one_minus_cos >= 2.0
+    }
+
+    /// Area of the cap on a sphere of `radius`.
+    #[inline]
+    pub fn area(&self, radius: f32) -> f32 {
+        2.0 * std::f32::consts::PI * radius * radius * self.one_minus_cos
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
     pub surface: SurfaceHit,
@@ -74,6 +110,8 @@ pub struct World {
     /// excluded), or around what the camera sees once `cover` was called.
     pub bounds_center: Vec3,
     pub bounds_radius: f32,
+    /// Per sphere, the cap that emits toward the scene (see `emitting_cap`).
+    caps: Vec<EmitterCap>,
 }
 
 impl World {
@@ -90,6 +128,7 @@ impl World {
             ambient: scene.ambient,
             bounds_center: Vec3::ZERO,
             bounds_radius: 0.0,
+            caps: Vec::new(),
         };
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for (index, object) in scene.objects.iter().enumerate() {
@@ -163,6 +202,7 @@ impl World {
                 }
             }
         }
+        world.caps = world.emitter_caps(None);
         world
     }
 
@@ -244,9 +284,10 @@ impl World {
     /// Make the photon-emission region (the directional lights' disc, and
     /// the part of giant emitters photons leave from) the bounding sphere of
     /// the visible points, with a margin for light that bounces in from just
-    /// outside the view. The bounds of all finite objects would not do when
-    /// walls are spheres of radius 1e5.
-    pub fn cover(&mut self, points: &[Vec3]) {
+    /// outside the view, and fit the emitters' caps to what `camera` can see.
+    /// The bounds of all finite objects would not do when walls are spheres
+    /// of radius 1e5.
+    pub fn cover(&mut self, points: &[Vec3], camera: &CameraModel) {
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for p in points {
             lo = lo.min(*p);
@@ -256,27 +297,77 @@ impl World {
             self.bounds_center = (lo + hi) * 0.5;
             self.bounds_radius = (hi - lo).length() * 0.75;
         }
+        self.caps = self.emitter_caps(Some(camera.origin_hull()));
     }
 
-    /// The part of an emissive sphere that lights the scene: (axis, 1 − cos θ
-    /// of the cap), 1 − cos θ = 2 for the whole sphere. A sphere larger than
-    /// the region the camera sees (smallpt's light of radius 600 over a room
-    /// of 100, whose cap inside the room is 2·10⁻⁴ of its area) is sampled
-    /// only on its cap within that region: photons leave from there, and
-    /// light sampling aims there (unbiased with MIS, which leaves the rest of
-    /// the sphere to BSDF sampling).
+    /// The part of sphere `sphere` that lights the scene, when it is an
+    /// emitter (the whole sphere otherwise).
     #[inline]
-    pub fn emitting_cap(&self, center: Vec3, radius: f32) -> (Vec3, f32) {
+    pub fn emitting_cap(&self, sphere: usize) -> EmitterCap {
+        self.caps.get(sphere).copied().unwrap_or(EmitterCap::WHOLE)
+    }
+
+    /// Each emissive sphere's cap:
+    /// - its part inside an opaque sphere that holds the camera (the middle
+    ///   of `origins`, the hull of its ray origins), the smallest such part.
+    ///   Paths that start inside that wall never leave it, so this is exactly
+    ///   what they can see; paths outside it find every light sample blocked
+    ///   and get the light through BSDF sampling alone, at full MIS weight.
+    ///   smallpt's light pokes 0.27 through the ceiling: the cap under it is
+    ///   1/700 of the next choice;
+    /// - otherwise, for a sphere larger than the region the camera sees, its
+    ///   part within that region (a guess: light from the rest is left to
+    ///   BSDF sampling).
+    fn emitter_caps(&self, origins: Option<([Vec3; 4], f32)>) -> Vec<EmitterCap> {
+        let s = &self.spheres;
+        let count = s.radius.len();
+        let material = |i: usize| &self.materials[self.objects[s.object[i] as usize].material as usize];
+        let enclosing: Vec<usize> = match origins {
+            Some((corners, margin)) => {
+                let eye = corners.iter().map(|c| c.as_dvec3()).sum::<glam::DVec3>() / 4.0;
+                (0..count)
+                    .filter(|&j| !matches!(material(j), MaterialModel::Glass { .. }))
+                    .filter(|&j| {
+                        (eye - s.center(j).as_dvec3()).length() + margin as f64 <= s.radius[j] as f64 * (1.0 - 1e-6)
+                    })
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        (0..count)
+            .map(|i| {
+                if !matches!(material(i), MaterialModel::Emissive { .. }) {
+                    return EmitterCap::WHOLE;
+                }
+                let (center, radius) = (s.center(i), s.radius[i]);
+                let walls = enclosing.iter().filter(|&&j| j != i).map(|&j| {
+                    // |p − c_j| ≤ R_j on the sphere ⇔ cos θ ≥ (r² + d² − R²)/(2 r d)
+                    let to_wall = s.center(j).as_dvec3() - center.as_dvec3();
+                    let (d, r, big) = (to_wall.length(), radius as f64, s.radius[j] as f64);
+                    if d <= 0.0 {
+                        return if r < big { EmitterCap::WHOLE } else { EmitterCap::about(Vec3::Z, 1.0) };
+                    }
+                    EmitterCap::about((to_wall / d).as_vec3(), (r * r + d * d - big * big) / (2.0 * r * d))
+                });
+                walls
+                    .min_by(|a, b| a.one_minus_cos.total_cmp(&b.one_minus_cos))
+                    .unwrap_or_else(|| self.region_cap(center, radius))
+            })
+            .collect()
+    }
+
+    /// The part of a sphere larger than the region the camera sees that lies
+    /// within it (the whole sphere for smaller ones).
+    fn region_cap(&self, center: Vec3, radius: f32) -> EmitterCap {
         let (region, extent) = (self.bounds_center, self.bounds_radius);
         let to_region = region - center;
         let distance = to_region.length();
         if radius <= extent || distance <= 0.0 || distance >= radius + extent || distance + radius <= extent {
-            return (Vec3::Z, 2.0);
+            return EmitterCap::WHOLE;
         }
         // |p − region|² ≤ extent² on the sphere ⇔ cos θ ≥ (r² + d² − R²)/(2 r d)
-        let cos_min =
-            ((radius * radius + distance * distance - extent * extent) / (2.0 * radius * distance)).clamp(-1.0, 1.0);
-        (to_region / distance, 1.0 - cos_min)
+        let (r, d, e) = (radius as f64, distance as f64, extent as f64);
+        EmitterCap::about(to_region / distance, ((r * r + d * d - e * e) / (2.0 * r * d)).clamp(-1.0, 1.0))
     }
 
     #[inline]
