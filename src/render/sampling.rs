@@ -14,12 +14,15 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
     const PI_2_HI: f32 = 1.570_312_5;
     const PI_2_MID: f32 = 4.837_513e-4;
     const PI_2_LO: f32 = 7.549_79e-8;
-    let quadrant = (x * FRAC_2_PI).round();
+    // Round to nearest through an integer: `f32::round` is a libm call
+    // without SSE4.1
+    let k = (x * FRAC_2_PI + 0.5f32.copysign(x)) as i32;
+    let quadrant = k as f32;
     let r = ((x - quadrant * PI_2_HI) - quadrant * PI_2_MID) - quadrant * PI_2_LO;
     let r2 = r * r;
     let sin = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));
     let cos = 1.0 - 0.5 * r2 + r2 * r2 * (4.166_664_6e-2 + r2 * (-1.388_731_6e-3 + r2 * 2.443_315_7e-5));
-    match (quadrant as i32) & 3 {
+    match k & 3 {
         0 => (sin, cos),
         1 => (cos, -sin),
         2 => (-sin, -cos),
