@@ -458,28 +458,38 @@ fn case_13_analytic_furnace() {
     assert!((direct - 0.5).abs() < 1e-3, "whitted: {direct}");
 }
 
-/// Pearson's χ² of sampled directions against the pdf, over (cos θ, φ) bins
-/// of the hemisphere; returns (statistic, degrees of freedom).
-fn chi_square(bsdf: &Bsdf, wo: Vec3) -> (f64, usize) {
+/// Pearson's χ² of sampled directions against the pdf, over (cos α, φ) bins
+/// about `axis` with cos α ≥ `cos_min`; returns (statistic, degrees of
+/// freedom). With `cos_min` > 0 the bins are a window on a sharp lobe, and
+/// one more bin holds every other outcome (outside the window, or no sample).
+fn chi_square(bsdf: &Bsdf, wo: Vec3, axis: Vec3, cos_min: f32) -> (f64, usize) {
     const THETA: usize = 10;
     const PHI: usize = 20;
     const SAMPLES: usize = 200_000;
+    let frame = gi_studio::geometry::Frame::from_z(axis);
+    let span = 1.0 - cos_min as f64;
     let mut observed = vec![0.0f64; THETA * PHI];
     let mut s = Sampler::new(14, 0, 14);
-    let bin = |d: Vec3| -> usize {
-        let t = ((d.z.clamp(0.0, 1.0)) * THETA as f32).min(THETA as f32 - 1.0) as usize;
-        let phi = d.y.atan2(d.x).rem_euclid(2.0 * PI);
+    let bin = |d: Vec3| -> Option<usize> {
+        let local = frame.to_local(d);
+        if local.z < cos_min {
+            return None;
+        }
+        let t = (((local.z - cos_min) as f64 / span * THETA as f64) as usize).min(THETA - 1);
+        let phi = local.y.atan2(local.x).rem_euclid(2.0 * PI);
         let p = ((phi / (2.0 * PI)) * PHI as f32).min(PHI as f32 - 1.0) as usize;
-        t * PHI + p
+        Some(t * PHI + p)
     };
     for _ in 0..SAMPLES {
         if let Some(b) = bsdf.sample(wo, Vec3::Z, s.next_f32(), s.next_2d(), Transport::Radiance) {
             if b.wi.z > 0.0 {
-                observed[bin(b.wi)] += 1.0;
+                if let Some(i) = bin(b.wi) {
+                    observed[i] += 1.0;
+                }
             }
         }
     }
-    // Expected counts: integrate the pdf over each bin (uniform in cos θ and φ)
+    // Expected counts: integrate the pdf over each bin (uniform in cos α and φ)
     let mut expected = vec![0.0f64; THETA * PHI];
     let sub = 12;
     for t in 0..THETA {
@@ -487,16 +497,20 @@ fn chi_square(bsdf: &Bsdf, wo: Vec3) -> (f64, usize) {
             let mut integral = 0.0;
             for i in 0..sub {
                 for j in 0..sub {
-                    let cos = (t as f64 + (i as f64 + 0.5) / sub as f64) / THETA as f64;
+                    let cos = cos_min as f64 + span * (t as f64 + (i as f64 + 0.5) / sub as f64) / THETA as f64;
                     let phi = (p as f64 + (j as f64 + 0.5) / sub as f64) / PHI as f64 * 2.0 * std::f64::consts::PI;
                     let sin = (1.0 - cos * cos).sqrt();
-                    let d = Vec3::new((sin * phi.cos()) as f32, (sin * phi.sin()) as f32, cos as f32);
-                    integral += bsdf.pdf(wo, d, Vec3::Z) as f64;
+                    let local = Vec3::new((sin * phi.cos()) as f32, (sin * phi.sin()) as f32, cos as f32);
+                    integral += bsdf.pdf(wo, frame.to_world(local), Vec3::Z) as f64;
                 }
             }
-            let area = (1.0 / THETA as f64) * (2.0 * std::f64::consts::PI / PHI as f64);
+            let area = (span / THETA as f64) * (2.0 * std::f64::consts::PI / PHI as f64);
             expected[t * PHI + p] = integral / (sub * sub) as f64 * area * SAMPLES as f64;
         }
+    }
+    if cos_min > 0.0 {
+        observed.push(SAMPLES as f64 - observed.iter().sum::<f64>());
+        expected.push(SAMPLES as f64 - expected.iter().sum::<f64>());
     }
     // Pool bins with few expected samples, as the test requires
     let (mut statistic, mut dof, mut pooled_o, mut pooled_e) = (0.0, 0usize, 0.0, 0.0);
@@ -542,15 +556,17 @@ fn case_14_energy_and_chi_square_per_material() {
             if matches!(bsdf, Bsdf::Lambert { .. } | Bsdf::Glass { .. }) {
                 assert!(energy > 0.99, "{bsdf:?} at {theta}°: loses energy ({energy})");
             }
-            // The χ² grid integrates the pdf on 12×12 points per bin: it cannot
-            // resolve a lobe sharper than that (exponent 500 is checked for
-            // energy only)
-            let resolvable = match bsdf {
-                Bsdf::Phong { exponent, .. } | Bsdf::BlinnPhong { exponent, .. } => *exponent <= 100.0,
-                _ => true,
+            // Bins over the hemisphere, or for a lobe too sharp for them (a
+            // pure Phong lobe of exponent 500 is 4° wide) a window about the
+            // mirror direction holding 99.9% of it: P(cos α < c) = c^(n+1)
+            let (axis, cos_min) = match bsdf {
+                Bsdf::Phong { kd, exponent, .. } if *kd == Vec3::ZERO && *exponent > 100.0 => {
+                    (Vec3::new(-wo.x, -wo.y, wo.z), 0.001f32.powf(1.0 / (exponent + 1.0)))
+                }
+                _ => (Vec3::Z, 0.0),
             };
-            if !matches!(bsdf, Bsdf::Glass { .. }) && theta < 80.0 && resolvable {
-                let (statistic, dof) = chi_square(bsdf, wo);
+            if !matches!(bsdf, Bsdf::Glass { .. }) && theta < 80.0 {
+                let (statistic, dof) = chi_square(bsdf, wo, axis, cos_min);
                 // Far beyond the 99.9% quantile would mean sampling and pdf disagree
                 let limit = dof as f64 + 5.0 * (2.0 * dof as f64).sqrt();
                 assert!(statistic < limit, "{bsdf:?} at {theta}°: χ² {statistic:.1} with {dof} dof");
