@@ -8,15 +8,22 @@ use super::{gamma, Ray, SurfaceHit};
 pub struct Triangle {
     pub vertices: [Vec3; 3],
     pub normal: Vec3,
+    /// A ball holding the triangle, for rejecting rays that pass far from it.
+    bound_center: Vec3,
+    bound_radius: f32,
 }
 
 impl Triangle {
     pub fn new(a: Vec3, b: Vec3, c: Vec3) -> Self {
         // Normal in f64 so thin but valid triangles far from the origin keep one
-        let n = (b.as_dvec3() - a.as_dvec3()).cross(c.as_dvec3() - a.as_dvec3());
+        let (a64, b64, c64) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+        let n = (b64 - a64).cross(c64 - a64);
         let length = n.length();
         let normal = if length > 0.0 && length.is_finite() { (n / length).as_vec3() } else { Vec3::ZERO };
-        Self { vertices: [a, b, c], normal }
+        // The ball about the centroid, measured from the centre as rounded to f32
+        let bound_center = ((a64 + b64 + c64) / 3.0).as_vec3();
+        let reach = [a64, b64, c64].map(|v| (v - bound_center.as_dvec3()).length()).into_iter().fold(0.0, f64::max);
+        Self { vertices: [a, b, c], normal, bound_center, bound_radius: (reach as f32).next_up() }
     }
 
     pub fn is_degenerate(&self) -> bool {
@@ -34,9 +41,29 @@ impl Triangle {
 /// shared edges and vertices hit exactly one side or both, never neither.
 #[inline]
 pub fn intersect_triangle(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<SurfaceHit> {
-    if triangle.is_degenerate() {
+    if triangle.is_degenerate() || !may_reach(ray, triangle.bound_center, triangle.bound_radius, t_max) {
         return None;
     }
+    watertight(ray, triangle, t_max)
+}
+
+/// Whether `ray` may meet the ball (`center`, `radius`) within (0, t_max):
+/// a few multiplies that spare most rays the watertight test. The ball is
+/// grown by a bound on the rounding of the closest approach, so a ray the
+/// watertight test would hit is never turned away (and the mesh stays
+/// watertight).
+#[inline]
+fn may_reach(ray: &Ray, center: Vec3, radius: f32, t_max: f32) -> bool {
+    let f = ray.origin - center;
+    let b = f.dot(ray.direction);
+    let closest = f - b * ray.direction;
+    let reach = radius + gamma(16) * (f.abs().element_sum() + radius);
+    // Beside the ray, wholly behind its origin, or wholly beyond t_max
+    closest.length_squared() <= reach * reach && b <= reach && -b - reach < t_max
+}
+
+#[inline]
+fn watertight(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<SurfaceHit> {
     let [p0, p1, p2] = triangle.vertices;
     // Translate vertices to the ray origin, permute so z is the largest axis of d
     let d = ray.direction;
@@ -119,6 +146,51 @@ mod tests {
         assert_eq!(hit.normal, Vec3::Z);
         assert!(intersect_triangle(&Ray::new(Vec3::new(2.0, 0.0, 2.0), -Vec3::Z), &tri, f32::INFINITY).is_none());
         assert!(intersect_triangle(&Ray::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::Z), &tri, 1.0).is_none());
+    }
+
+    /// The ball in front of the watertight test never turns a hit into a
+    /// miss: triangles at scales 1e-6 … 1e6, from 1e-3 to 1e3 of their size
+    /// away, rays aimed at vertices, edge points and interiors.
+    #[test]
+    fn bounding_ball_never_turns_away_a_hit() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut hits, mut misses, mut turned_away) = (0, 0, 0);
+        for case in 0..40_000 {
+            let scale = 10f32.powf(uniform() * 12.0 - 6.0);
+            let mut point = || Vec3::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5) * 2.0;
+            let offset = point() * scale * 100.0;
+            let tri = Triangle::new(offset + point() * scale, offset + point() * scale, offset + point() * scale);
+            // Vertices, edge midpoints and interior points
+            let [a, b, c] = tri.vertices;
+            let target = match case % 3 {
+                0 => [a, b, c][case / 3 % 3],
+                1 => (a + b) * 0.5,
+                _ => a * 0.2 + b * 0.3 + c * 0.5,
+            };
+            let origin = target + point().normalize() * scale * 10f32.powf(uniform() * 6.0 - 3.0);
+            let ray = Ray::new(origin, (target - origin).normalize());
+            let reach = may_reach(&ray, tri.bound_center, tri.bound_radius, f32::INFINITY);
+            if watertight(&ray, &tri, f32::INFINITY).is_some() {
+                hits += 1;
+                assert!(reach, "case {case}: a hit turned away by the bound of {tri:?}, ray {ray:?}");
+            }
+            // A ray sent the opposite way misses; from outside the ball, the
+            // ball should turn it away
+            let away = Ray::new(origin, -ray.direction);
+            let outside = (origin - tri.bound_center).length() > 2.0 * tri.bound_radius;
+            if outside && watertight(&away, &tri, f32::INFINITY).is_none() {
+                misses += 1;
+                turned_away += !may_reach(&away, tri.bound_center, tri.bound_radius, f32::INFINITY) as u32;
+            }
+        }
+        assert!(hits > 20_000, "only {hits} hits");
+        assert!(misses > 10_000 && turned_away == misses, "{turned_away} of {misses} misses turned away");
     }
 
     #[test]
