@@ -81,18 +81,10 @@ impl CameraModel {
         Some(Vec2::new((sx + 1.0) * 0.5 * self.width, (1.0 - sy) * 0.5 * self.height))
     }
 
-    /// Where primary rays start: every origin lies within `margin` of the
-    /// quadrilateral `corners`. Origins sit on the near-clip plane at
-    /// `lens·(1 − k) + pinhole·k`, k = near / focus, so the set is the pinhole
-    /// rectangle widened by the lens disc scaled by |1 − k|.
-    pub fn origin_hull(&self) -> ([Vec3; 4], f32) {
-        let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(sx, sy): (f32, f32)| {
-            self.position
-                + (self.forward + self.right * (sx * self.half_width) + self.up * (sy * self.half_height))
-                    * self.near_clip
-        });
-        let k = if self.focus_distance > 0.0 { self.near_clip / self.focus_distance } else { 0.0 };
-        (corners, self.aperture_radius * (1.0 - k).abs())
+    /// Where the central ray starts: the middle of the near-clip rectangle
+    /// (the lens centre when there is no near clip).
+    pub fn central_origin(&self) -> Vec3 {
+        self.position + self.forward * self.near_clip
     }
 
     /// The ray through the centre of pixel (x, y), for picking.
@@ -137,32 +129,17 @@ mod tests {
         assert!(model.project(Vec3::new(0.0, 0.0, 9.0)).is_none());
     }
 
-    /// Every primary ray origin, pinhole or thin lens, lies in the hull.
     #[test]
-    fn ray_origins_lie_in_the_origin_hull() {
-        use crate::render::rng::Sampler;
+    fn central_origin_is_where_the_central_ray_starts() {
         for aperture in [0.0, 0.4] {
-            let mut cam = camera();
-            cam.aperture_radius = aperture;
-            let model = CameraModel::new(&cam, 64, 48);
-            let (corners, margin) = model.origin_hull();
-            // The hull is a rectangle in the near-clip plane: its centre and half extents
-            let centre = corners.iter().copied().sum::<Vec3>() / 4.0;
-            let (half_x, half_y) = ((corners[1] - corners[0]).length() * 0.5, (corners[3] - corners[0]).length() * 0.5);
-            let mut s = Sampler::new(0, 0, 3);
-            let outside_of = |origin: Vec3| {
-                let origin = origin - centre;
-                (origin, Vec2::new((origin.x.abs() - half_x).max(0.0), (origin.y.abs() - half_y).max(0.0)).length())
-            };
-            for _ in 0..10_000 {
-                let film = Vec2::new(s.next_f32() * 64.0, s.next_f32() * 48.0);
-                let (origin, outside) = outside_of(model.generate_ray(film, s.next_2d()).origin);
-                assert!(origin.z.abs() < 1e-5, "origin off the near-clip plane: {origin}");
-                assert!(outside <= margin + 1e-5, "origin {origin} outside the hull by {outside}");
-            }
-            // The margin is tight: the left edge seen through the lens' left edge reaches it
-            let (_, outside) = outside_of(model.generate_ray(Vec2::new(0.0, 24.0), Vec2::new(0.0, 0.5)).origin);
-            assert!((outside - margin).abs() < 1e-5, "margin {margin}, reached {outside}");
+            let model = CameraModel::new(&Camera { aperture_radius: aperture, ..camera() }, 64, 48);
+            let ray = model.generate_ray(Vec2::new(32.0, 24.0), Vec2::splat(0.5));
+            assert!(
+                (ray.origin - model.central_origin()).length() < 1e-5,
+                "{} vs {}",
+                ray.origin,
+                model.central_origin()
+            );
         }
     }
 

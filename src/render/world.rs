@@ -307,7 +307,7 @@ impl World {
             self.bounds_center = (lo + hi) * 0.5;
             self.bounds_radius = (hi - lo).length() * 0.75;
         }
-        self.caps = self.emitter_caps(Some(camera.origin_hull()));
+        self.caps = self.emitter_caps(Some(camera.central_origin()));
     }
 
     /// The part of sphere `sphere` that lights the scene, when it is an
@@ -318,8 +318,8 @@ impl World {
     }
 
     /// Each emissive sphere's cap:
-    /// - its part inside an opaque sphere that holds the camera (the middle
-    ///   of `origins`, the hull of its ray origins), the smallest such part.
+    /// - its part inside an opaque sphere that holds the camera (`eye`, where
+    ///   its central ray starts), the smallest such part.
     ///   Paths that start inside that wall never leave it, so this is exactly
     ///   what they can see; paths outside it find every light sample blocked
     ///   and get the light through BSDF sampling alone, at full MIS weight.
@@ -328,20 +328,15 @@ impl World {
     /// - otherwise, for a sphere larger than the region the camera sees, its
     ///   part within that region (a guess: light from the rest is left to
     ///   BSDF sampling).
-    fn emitter_caps(&self, origins: Option<([Vec3; 4], f32)>) -> Vec<EmitterCap> {
+    fn emitter_caps(&self, eye: Option<Vec3>) -> Vec<EmitterCap> {
         let s = &self.spheres;
         let count = s.radius.len();
         let material = |i: usize| &self.materials[self.objects[s.object[i] as usize].material as usize];
-        let enclosing: Vec<usize> = match origins {
-            Some((corners, margin)) => {
-                let eye = corners.iter().map(|c| c.as_dvec3()).sum::<glam::DVec3>() / 4.0;
-                (0..count)
-                    .filter(|&j| !matches!(material(j), MaterialModel::Glass { .. }))
-                    .filter(|&j| {
-                        (eye - s.center(j).as_dvec3()).length() + margin as f64 <= s.radius[j] as f64 * (1.0 - 1e-6)
-                    })
-                    .collect()
-            }
+        let enclosing: Vec<usize> = match eye {
+            Some(eye) => (0..count)
+                .filter(|&j| !matches!(material(j), MaterialModel::Glass { .. }))
+                .filter(|&j| (eye.as_dvec3() - s.center(j).as_dvec3()).length() <= s.radius[j] as f64 * (1.0 - 1e-6))
+                .collect(),
             None => Vec::new(),
         };
         (0..count)
