@@ -9,6 +9,7 @@ use super::kdtree::Neighbours;
 use super::maps::{estimate, PhotonMaps, QueryStats};
 use crate::geometry::Ray;
 use crate::render::bsdf::{Bsdf, Transport};
+use crate::render::occluders::Occluders;
 use crate::render::rng::Sampler;
 use crate::render::world::{Hit, World};
 use crate::render::{Counters, PhotonSettings};
@@ -31,6 +32,8 @@ impl PhotonScratch {
 
 pub struct PhotonRenderer<'a> {
     pub world: &'a World,
+    /// What blocks the shadow rays of the path being traced.
+    pub occluders: Occluders<'a>,
     pub maps: &'a PhotonMaps,
     pub settings: &'a PhotonSettings,
     pub max_depth: u32,
@@ -172,7 +175,7 @@ impl PhotonRenderer<'_> {
         scratch: &mut PhotonScratch,
     ) -> Rgb {
         let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
-        let mut radiance = direct_light(self.world, hit, wo, facing, bsdf, sampler, counters);
+        let mut radiance = direct_light(self.occluders, hit, wo, facing, bsdf, sampler, counters);
         radiance +=
             estimate(&self.maps.caustic, point, facing, wo, bsdf, k, r, &mut scratch.neighbours, &mut scratch.queries);
         if global {
@@ -195,7 +198,7 @@ impl PhotonRenderer<'_> {
 /// Direct light by shadow rays, one sample of every light (less noise than
 /// one light per sample, and photon mapping's cost is elsewhere).
 pub fn direct_light(
-    world: &World,
+    occluders: Occluders,
     hit: &Hit,
     wo: Vec3,
     facing: Vec3,
@@ -203,6 +206,7 @@ pub fn direct_light(
     sampler: &mut Sampler,
     counters: &mut Counters,
 ) -> Rgb {
+    let world = occluders.world();
     let mut radiance = Rgb::ZERO;
     for light in &world.lights {
         let Some(sample) = light.sample(world, &hit.surface, sampler.next_2d()) else {
@@ -213,7 +217,7 @@ pub fn direct_light(
             continue;
         }
         counters.rays += 1;
-        if !world.occluded(&sample.shadow, sample.shadow_t_max) {
+        if !occluders.blocks(&sample) {
             radiance += f * sample.value * sample.wi.dot(facing);
         }
     }

@@ -14,6 +14,7 @@ use super::integrator::direct_light;
 use super::kdtree::PhotonKdTree;
 use crate::geometry::Ray;
 use crate::render::bsdf::{Bsdf, Transport};
+use crate::render::occluders::Occluders;
 use crate::render::rng::Sampler;
 use crate::render::world::World;
 use crate::render::Counters;
@@ -91,6 +92,7 @@ pub fn camera_pass(
     sampler: &mut Sampler,
     counters: &mut Counters,
 ) -> (Rgb, Option<VisiblePoint>) {
+    let occluders = Occluders::for_path(world, ray.origin);
     let mut ray = *ray;
     let mut throughput = Rgb::ONE;
     let mut radiance = Rgb::ZERO;
@@ -112,7 +114,7 @@ pub fn camera_pass(
             continue;
         }
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
-        radiance += throughput * direct_light(world, &hit, wo, facing, &bsdf, sampler, counters);
+        radiance += throughput * direct_light(occluders, &hit, wo, facing, &bsdf, sampler, counters);
         if world.background != Rgb::ZERO {
             if let Some(s) = bsdf.sample(wo, n, sampler.next_f32(), sampler.next_2d(), Transport::Radiance) {
                 counters.rays += 1;

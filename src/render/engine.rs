@@ -14,6 +14,7 @@ use rayon::prelude::*;
 
 use super::camera::CameraModel;
 use super::image::LinearImage;
+use super::occluders::Occluders;
 use super::rng::Sampler;
 use super::settings::{Algorithm, RenderSettings};
 use super::tiles::{tile_layout, TileAccumulator, TileRect};
@@ -438,6 +439,7 @@ impl FrameContext<'_> {
             (Method::Photon(maps), Some(scratch)) => {
                 let renderer = PhotonRenderer {
                     world: &self.world,
+                    occluders: Occluders::for_path(&self.world, ray.origin),
                     maps,
                     settings: &settings.photon,
                     max_depth: settings.max_depth,

@@ -47,6 +47,8 @@ pub struct LightSample {
     /// The shadow ray and how far it may go.
     pub shadow: Ray,
     pub shadow_t_max: f32,
+    /// The triangle the sample lies on, which its shadow ray cannot cross.
+    pub on_triangle: Option<u32>,
 }
 
 /// The thesis' spot factor: 0 outside the cone, (Vp·Va)^σ inside.
@@ -76,7 +78,14 @@ impl LightSource {
                 let (shadow, shadow_t_max) = at.spawn_ray_to(position, 0.0);
                 let d = (position - p).length();
                 let value = intensity * attenuation.factor(d);
-                Some(LightSample { wi: shadow.direction, value, pdf: f32::INFINITY, shadow, shadow_t_max })
+                Some(LightSample {
+                    wi: shadow.direction,
+                    value,
+                    pdf: f32::INFINITY,
+                    shadow,
+                    shadow_t_max,
+                    on_triangle: None,
+                })
             }
             LightSource::Spot { position, direction, cos_cone, exponent, intensity, attenuation } => {
                 let (shadow, shadow_t_max) = at.spawn_ray_to(position, 0.0);
@@ -86,7 +95,14 @@ impl LightSource {
                     return None;
                 }
                 let value = intensity * (attenuation.factor(d) * factor);
-                Some(LightSample { wi: shadow.direction, value, pdf: f32::INFINITY, shadow, shadow_t_max })
+                Some(LightSample {
+                    wi: shadow.direction,
+                    value,
+                    pdf: f32::INFINITY,
+                    shadow,
+                    shadow_t_max,
+                    on_triangle: None,
+                })
             }
             LightSource::Directional { direction, irradiance } => {
                 let shadow = at.spawn_ray(-direction);
@@ -96,6 +112,7 @@ impl LightSource {
                     pdf: f32::INFINITY,
                     shadow,
                     shadow_t_max: f32::INFINITY,
+                    on_triangle: None,
                 })
             }
             LightSource::Area { object, radiance } => {
@@ -105,7 +122,18 @@ impl LightSource {
                 if normal.dot(-shadow.direction) <= 0.0 || pdf.is_nan() || pdf <= 0.0 {
                     return None;
                 }
-                Some(LightSample { wi: shadow.direction, value: radiance / pdf, pdf, shadow, shadow_t_max })
+                let on_triangle = match world.objects[object as usize].shape {
+                    ShapeRef::Triangle(t) => Some(t),
+                    _ => None,
+                };
+                Some(LightSample {
+                    wi: shadow.direction,
+                    value: radiance / pdf,
+                    pdf,
+                    shadow,
+                    shadow_t_max,
+                    on_triangle,
+                })
             }
         }
     }

@@ -6,6 +6,7 @@ pub mod camera;
 pub mod engine;
 pub mod image;
 pub mod light;
+pub mod occluders;
 pub mod path;
 pub mod rng;
 pub mod sampling;

@@ -4,6 +4,7 @@
 
 use super::bsdf::{Bsdf, Transport};
 use super::light::area_pdf;
+use super::occluders::Occluders;
 use super::rng::Sampler;
 use super::sampling::power_heuristic;
 use super::world::World;
@@ -15,6 +16,7 @@ use crate::scene::Rgb;
 const ROULETTE_DEPTH: u32 = 3;
 
 pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
+    let occluders = Occluders::for_path(world, ray.origin);
     let mut ray = *ray;
     let mut radiance = Rgb::ZERO;
     let mut throughput = Rgb::ONE;
@@ -57,7 +59,7 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
                 let f = bsdf.eval(wo, sample.wi, facing);
                 if f != Rgb::ZERO {
                     counters.rays += 1;
-                    if !world.occluded(&sample.shadow, sample.shadow_t_max) {
+                    if !occluders.blocks(&sample) {
                         let weight = if light.is_delta() {
                             1.0
                         } else {

@@ -11,6 +11,7 @@ use std::f32::consts::FRAC_1_PI;
 use glam::Vec3;
 
 use super::bsdf::{reflect, refract};
+use super::occluders::Occluders;
 use super::rng::Sampler;
 use super::world::{Hit, World};
 use super::Counters;
@@ -28,6 +29,19 @@ pub fn radiance(
     sampler: &mut Sampler,
     counters: &mut Counters,
 ) -> Rgb {
+    trace(Occluders::for_path(world, ray.origin), ray, depth_left, weight, sampler, counters)
+}
+
+/// The recursion, for a path that started where `occluders` was made.
+fn trace(
+    occluders: Occluders,
+    ray: &Ray,
+    depth_left: u32,
+    weight: f32,
+    sampler: &mut Sampler,
+    counters: &mut Counters,
+) -> Rgb {
+    let world = occluders.world();
     counters.rays += 1;
     let Some(hit) = world.intersect(ray, f32::INFINITY) else {
         return world.background;
@@ -39,18 +53,19 @@ pub fn radiance(
     match *world.material_of(&hit) {
         MaterialModel::Emissive { .. } => world.emitted(&hit, wo),
         MaterialModel::Lambert { albedo } => {
-            albedo * world.ambient + local(world, &hit, facing, wo, albedo, Rgb::ZERO, 0.0, false, sampler, counters)
+            albedo * world.ambient
+                + local(occluders, &hit, facing, wo, albedo, Rgb::ZERO, 0.0, false, sampler, counters)
         }
         MaterialModel::Phong { ka, kd, ks, shininess } | MaterialModel::BlinnPhong { ka, kd, ks, shininess } => {
             let blinn = matches!(world.material_of(&hit), MaterialModel::BlinnPhong { .. });
             let mut c =
-                ka * world.ambient + local(world, &hit, facing, wo, kd, ks, shininess, blinn, sampler, counters);
+                ka * world.ambient + local(occluders, &hit, facing, wo, kd, ks, shininess, blinn, sampler, counters);
             // The thesis' loop: the surface's reflectivity scales a mirror bounce
             let w = weight * ks.max_element();
             if can_recurse && w > MIN_WEIGHT {
                 c += ks
-                    * radiance(
-                        world,
+                    * trace(
+                        occluders,
                         &hit.surface.spawn_ray(reflect(wo, facing)),
                         depth_left - 1,
                         w,
@@ -65,7 +80,7 @@ pub fn radiance(
             if !can_recurse || w <= MIN_WEIGHT {
                 return Rgb::ZERO;
             }
-            tint * radiance(world, &hit.surface.spawn_ray(reflect(wo, facing)), depth_left - 1, w, sampler, counters)
+            tint * trace(occluders, &hit.surface.spawn_ray(reflect(wo, facing)), depth_left - 1, w, sampler, counters)
         }
         MaterialModel::Glass { ior, tint } => {
             if !can_recurse {
@@ -75,8 +90,8 @@ pub fn radiance(
             let (fresnel, refracted, eta) = refract(wo, facing, eta_i, eta_t);
             let mut c = Rgb::ZERO;
             if weight * fresnel > MIN_WEIGHT {
-                let reflected = radiance(
-                    world,
+                let reflected = trace(
+                    occluders,
                     &hit.surface.spawn_ray(reflect(wo, facing)),
                     depth_left - 1,
                     weight * fresnel,
@@ -89,7 +104,7 @@ pub fn radiance(
                 let w = weight * (1.0 - fresnel);
                 if w > MIN_WEIGHT {
                     // Radiance is compressed by η² crossing into the denser side
-                    let through = radiance(world, &hit.surface.spawn_ray(wt), depth_left - 1, w, sampler, counters);
+                    let through = trace(occluders, &hit.surface.spawn_ray(wt), depth_left - 1, w, sampler, counters);
                     c += (1.0 - fresnel) * eta * eta * through;
                 }
             }
@@ -101,7 +116,7 @@ pub fn radiance(
 /// The local model summed over lights that see the point.
 #[allow(clippy::too_many_arguments)]
 fn local(
-    world: &World,
+    occluders: Occluders,
     hit: &Hit,
     n: Vec3,
     wo: Vec3,
@@ -112,6 +127,7 @@ fn local(
     sampler: &mut Sampler,
     counters: &mut Counters,
 ) -> Rgb {
+    let world = occluders.world();
     let mut total = Rgb::ZERO;
     for light in &world.lights {
         let Some(sample) = light.sample(world, &hit.surface, sampler.next_2d()) else {
@@ -122,7 +138,7 @@ fn local(
             continue;
         }
         counters.rays += 1;
-        if world.occluded(&sample.shadow, sample.shadow_t_max) {
+        if occluders.blocks(&sample) {
             continue;
         }
         let light_colour = sample.value * FRAC_1_PI;

@@ -6,6 +6,7 @@ use glam::Vec3;
 
 use super::camera::CameraModel;
 use super::light::LightSource;
+use super::occluders::Walls;
 use super::spheres::SphereLanes;
 use crate::geometry::{intersect_triangle, Frame, Ray, SurfaceHit, Triangle};
 use crate::geometry::{plane_hit, plane_t, sphere_hit};
@@ -62,11 +63,13 @@ pub struct PlaneShape {
 pub struct EmitterCap {
     pub frame: Frame,
     pub one_minus_cos: f32,
+    /// The sphere whose inside the cap was cut to, if any.
+    pub wall: Option<u32>,
 }
 
 impl EmitterCap {
     pub const WHOLE: EmitterCap =
-        EmitterCap { frame: Frame { x: Vec3::X, y: Vec3::Y, z: Vec3::Z }, one_minus_cos: 2.0 };
+        EmitterCap { frame: Frame { x: Vec3::X, y: Vec3::Y, z: Vec3::Z }, one_minus_cos: 2.0, wall: None };
 
     /// The part of the sphere (`center`, `radius`) inside the sphere
     /// (`other`, `other_radius`): |p − c_o| ≤ R_o on the first sphere ⇔
@@ -85,7 +88,7 @@ impl EmitterCap {
         if one_minus_cos >= 2.0 {
             return Self::WHOLE;
         }
-        EmitterCap { frame: Frame::from_z(axis), one_minus_cos }
+        EmitterCap { frame: Frame::from_z(axis), one_minus_cos, wall: None }
     }
 
     pub fn is_whole(&self) -> bool {
@@ -122,6 +125,8 @@ pub struct World {
     pub bounds_radius: f32,
     /// Per sphere, the cap that emits toward the scene (see `emitting_cap`).
     caps: Vec<EmitterCap>,
+    /// Spheres that shadow rays from inside them may skip (see `Occluders`).
+    pub(crate) walls: Walls,
 }
 
 impl World {
@@ -139,6 +144,7 @@ impl World {
             bounds_center: Vec3::ZERO,
             bounds_radius: 0.0,
             caps: Vec::new(),
+            walls: Walls::default(),
         };
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for (index, object) in scene.objects.iter().enumerate() {
@@ -307,7 +313,9 @@ impl World {
             self.bounds_center = (lo + hi) * 0.5;
             self.bounds_radius = (hi - lo).length() * 0.75;
         }
-        self.caps = self.emitter_caps(Some(camera.central_origin()));
+        let eye = camera.central_origin();
+        self.caps = self.emitter_caps(Some(eye));
+        self.walls = Walls::find(self, eye);
     }
 
     /// The part of sphere `sphere` that lights the scene, when it is an
@@ -348,7 +356,10 @@ impl World {
                 enclosing
                     .iter()
                     .filter(|&&j| j != i)
-                    .map(|&j| EmitterCap::inside(center, radius, s.center(j), s.radius[j]))
+                    .map(|&j| EmitterCap {
+                        wall: Some(j as u32),
+                        ..EmitterCap::inside(center, radius, s.center(j), s.radius[j])
+                    })
                     .min_by(|a, b| a.one_minus_cos.total_cmp(&b.one_minus_cos))
                     .unwrap_or_else(|| self.region_cap(center, radius))
             })

@@ -1,0 +1,309 @@
+//! What can block a shadow ray, and what need not be tested.
+//! - Walls: a path that starts inside an opaque sphere, or on one side of an
+//!   opaque plane, never leaves it; and a segment between two points of a
+//!   ball or a half-space stays in it. So when such a wall also holds every
+//!   light's sample points (smallpt's six spheres of radius 1e5, the Cornell
+//!   box's five planes), the shadow rays of paths from inside skip it.
+//! - The light's own triangle: a shadow ray ends on the triangle's plane
+//!   and meets that plane nowhere else.
+
+use glam::{DVec3, Vec3};
+
+use super::light::{LightSample, LightSource};
+use super::spheres::SphereLanes;
+use super::world::{PlaneShape, ShapeRef, World};
+use crate::geometry::{intersect_triangle, plane_t};
+use crate::scene::MaterialModel;
+
+/// A region a wall bounds, in f64 for exact inside tests.
+#[derive(Clone, Copy, Debug)]
+enum Region {
+    Ball {
+        center: DVec3,
+        radius: f64,
+    },
+    /// `normal · p > offset`: the side the camera is on.
+    HalfSpace {
+        normal: DVec3,
+        offset: f64,
+    },
+}
+
+impl Region {
+    /// Whether the ball (`center`, `reach`) lies in the region, touching
+    /// its boundary at most.
+    fn holds(&self, center: DVec3, reach: f64) -> bool {
+        match *self {
+            Region::Ball { center: c, radius } => (center - c).length() + reach <= radius,
+            Region::HalfSpace { normal, offset } => normal.dot(center) - offset >= reach,
+        }
+    }
+
+    /// Strictly inside: where a path may start.
+    fn holds_strictly(&self, p: DVec3) -> bool {
+        match *self {
+            Region::Ball { center, radius } => (p - center).length_squared() < radius * radius,
+            Region::HalfSpace { normal, offset } => normal.dot(p) > offset,
+        }
+    }
+}
+
+/// Walls that shadow rays from inside all of them may skip, and the rest.
+#[derive(Clone, Debug, Default)]
+pub struct Walls {
+    regions: Vec<Region>,
+    /// The spheres and planes that are not walls.
+    spheres: SphereLanes,
+    planes: Vec<PlaneShape>,
+}
+
+impl Walls {
+    /// Opaque, non-emissive spheres and planes with `eye` (where the camera's
+    /// rays start) strictly inside and every light's sample points inside;
+    /// none where a light has samples everywhere (a directional light).
+    pub fn find(world: &World, eye: Vec3) -> Self {
+        let eye = eye.as_dvec3();
+        let opaque = |object: u32| {
+            let material = &world.materials[world.objects[object as usize].material as usize];
+            !matches!(material, MaterialModel::Glass { .. } | MaterialModel::Emissive { .. })
+        };
+        let is_wall = |region: &Region, object: u32| {
+            opaque(object)
+                && region.holds_strictly(eye)
+                && world.lights.iter().all(|light| holds_samples(world, light, region, object))
+        };
+        let s = &world.spheres;
+        let (mut regions, mut others) = (Vec::new(), Vec::new());
+        for j in 0..s.radius.len() {
+            let region = Region::Ball { center: s.center(j).as_dvec3(), radius: s.radius[j] as f64 };
+            if is_wall(&region, s.object[j]) {
+                regions.push(region);
+            } else {
+                others.push(j);
+            }
+        }
+        let mut planes = Vec::new();
+        for plane in &world.planes {
+            // Facing the camera's side
+            let (normal, offset) = (plane.normal.as_dvec3(), plane.offset as f64);
+            let side = if normal.dot(eye) > offset { 1.0 } else { -1.0 };
+            let region = Region::HalfSpace { normal: normal * side, offset: offset * side };
+            if is_wall(&region, plane.object) {
+                regions.push(region);
+            } else {
+                planes.push(*plane);
+            }
+        }
+        if regions.is_empty() {
+            return Walls::default();
+        }
+        let centers: Vec<Vec3> = others.iter().map(|&j| s.center(j)).collect();
+        let radii: Vec<f32> = others.iter().map(|&j| s.radius[j]).collect();
+        Walls { regions, spheres: SphereLanes::new(&centers, &radii), planes }
+    }
+}
+
+/// Whether every sample `light` can give lies in `region`, the inside of
+/// the wall `object`.
+fn holds_samples(world: &World, light: &LightSource, region: &Region, object: u32) -> bool {
+    match *light {
+        LightSource::Point { position, .. } | LightSource::Spot { position, .. } => {
+            region.holds(position.as_dvec3(), 0.0)
+        }
+        LightSource::Directional { .. } => false,
+        LightSource::Area { object: emitter, .. } => match world.objects[emitter as usize].shape {
+            ShapeRef::Sphere(i) => {
+                let i = i as usize;
+                let cap = world.emitting_cap(i);
+                if cap.wall.is_some_and(|wall| world.spheres.object[wall as usize] == object) {
+                    // Cut to this wall's inside: in it by construction
+                    return true;
+                }
+                let (c, r) = (world.spheres.center(i).as_dvec3(), world.spheres.radius[i] as f64);
+                let cos_min = 1.0 - cap.one_minus_cos as f64;
+                if cos_min > 0.0 {
+                    // The ball on the cap's rim circle holds the cap
+                    let rim_center = c + cap.frame.z.as_dvec3() * (r * cos_min);
+                    region.holds(rim_center, r * (1.0 - cos_min * cos_min).sqrt() * (1.0 + 1e-6))
+                } else {
+                    region.holds(c, r)
+                }
+            }
+            ShapeRef::Triangle(t) => {
+                world.triangles[t as usize].0.vertices.iter().all(|v| region.holds(v.as_dvec3(), 0.0))
+            }
+            ShapeRef::Plane(_) => false,
+        },
+    }
+}
+
+/// What can block the shadow rays of one path.
+#[derive(Clone, Copy)]
+pub struct Occluders<'w> {
+    world: &'w World,
+    spheres: &'w SphereLanes,
+    planes: &'w [PlaneShape],
+}
+
+impl<'w> Occluders<'w> {
+    /// For a path whose camera ray starts at `origin`.
+    #[inline]
+    pub fn for_path(world: &'w World, origin: Vec3) -> Self {
+        let walls = &world.walls;
+        let origin = origin.as_dvec3();
+        if !walls.regions.is_empty() && walls.regions.iter().all(|region| region.holds_strictly(origin)) {
+            Occluders { world, spheres: &walls.spheres, planes: &walls.planes }
+        } else {
+            Occluders { world, spheres: &world.spheres.lanes, planes: &world.planes }
+        }
+    }
+
+    pub fn world(&self) -> &'w World {
+        self.world
+    }
+
+    /// Whether anything lies between the shading point and the light sample.
+    #[inline]
+    pub fn blocks(&self, sample: &LightSample) -> bool {
+        let (ray, t_max) = (&sample.shadow, sample.shadow_t_max);
+        self.spheres.any_hit(ray, t_max)
+            || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
+            || self.world.triangles.iter().enumerate().any(|(i, (triangle, _))| {
+                sample.on_triangle != Some(i as u32) && intersect_triangle(ray, triangle, t_max).is_some()
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Ray;
+    use crate::render::camera::CameraModel;
+    use crate::render::rng::Sampler;
+    use crate::render::sampling::uniform_sphere;
+    use crate::scene::{Light, LightKind, Scene};
+
+    fn preset(name: &str) -> Scene {
+        crate::scene::presets::preset(name).and_then(Result::ok).expect("preset")
+    }
+
+    fn world(scene: &Scene) -> World {
+        let mut world = World::new(scene);
+        let camera = CameraModel::new(&scene.camera, 64, 48);
+        let points = world.visible_points(&camera, 64, 48);
+        world.cover(&points, &camera);
+        world
+    }
+
+    fn point_light(position: Vec3) -> Light {
+        Light {
+            name: "extra".into(),
+            kind: LightKind::Point { position },
+            color: Vec3::ONE,
+            intensity: 1.0,
+            attenuation: Default::default(),
+            enabled: true,
+        }
+    }
+
+    #[test]
+    fn walls_of_smallpt_and_the_cornell_box() {
+        let w = world(&preset("smallpt"));
+        assert_eq!((w.walls.regions.len(), w.walls.spheres.len(), w.walls.planes.len()), (6, 3, 0));
+        let w = world(&preset("cornell"));
+        assert_eq!((w.walls.regions.len(), w.walls.spheres.len(), w.walls.planes.len()), (5, 2, 0));
+    }
+
+    /// A wall must hold every light: a point light above smallpt's ceiling
+    /// leaves five walls, a directional light none.
+    #[test]
+    fn a_light_outside_a_wall_keeps_it_tested() {
+        let mut scene = preset("smallpt");
+        scene.lights.push(point_light(Vec3::new(50.0, 200.0, 80.0)));
+        let w = world(&scene);
+        assert_eq!((w.walls.regions.len(), w.walls.spheres.len()), (5, 4));
+        scene.lights.push(Light { kind: LightKind::Directional { direction: -Vec3::Y }, ..point_light(Vec3::ZERO) });
+        assert!(world(&scene).walls.regions.is_empty());
+        let mut scene = preset("cornell");
+        scene.lights.push(point_light(Vec3::new(0.0, 1.0, -3.0)));
+        let w = world(&scene);
+        assert_eq!((w.walls.regions.len(), w.walls.planes.len()), (4, 1), "the back wall has a light behind it");
+    }
+
+    /// A path that starts outside a wall (smallpt's top rows start above the
+    /// ceiling) tests everything.
+    #[test]
+    fn paths_from_outside_test_every_sphere() {
+        let w = world(&preset("smallpt"));
+        assert_eq!(Occluders::for_path(&w, Vec3::new(50.0, 52.0, 150.0)).spheres.len(), 3);
+        assert_eq!(Occluders::for_path(&w, Vec3::new(50.0, 82.0, 150.0)).spheres.len(), 9);
+    }
+
+    /// Whether `p` lies within rounding of a wall's surface.
+    fn on_a_wall(walls: &Walls, p: DVec3) -> bool {
+        walls.regions.iter().any(|region| match *region {
+            Region::Ball { center, radius } => ((p - center).length() - radius).abs() <= 1e-7 * radius + 1e-4,
+            Region::HalfSpace { normal, offset } => (normal.dot(p) - offset).abs() <= 1e-6 * (1.0 + offset.abs()),
+        })
+    }
+
+    /// Against testing everything, on random paths through every preset,
+    /// and through smallpt and the Cornell box with a point light outside
+    /// one wall. Skipping may lose only blockers that rounding put at the
+    /// very end of a segment: a light sample on a wall's surface (smallpt's
+    /// light is cut at the ceiling), or one a hair behind its own triangle.
+    #[test]
+    fn skipping_agrees_with_testing_everything() {
+        let mut scenes: Vec<(String, Scene)> =
+            ["smallpt", "cornell", "caustics", "lights", "thesis"].map(|n| (n.to_string(), preset(n))).into();
+        for (name, outside) in [("smallpt", Vec3::new(50.0, 100.0, 80.0)), ("cornell", Vec3::new(0.0, 1.0, -1.5))] {
+            let mut scene = preset(name);
+            scene.lights.push(point_light(outside));
+            scenes.push((format!("{name} with a light outside"), scene));
+        }
+        for (name, scene) in &scenes {
+            let w = world(scene);
+            let camera = CameraModel::new(&scene.camera, 64, 48);
+            let mut s = Sampler::new(0, 0, 5);
+            let (mut samples, mut blocked, mut skipping_paths) = (0u32, 0u32, 0u32);
+            for _ in 0..4000 {
+                let mut ray = camera.pixel_ray(64.0 * s.next_f32(), 48.0 * s.next_f32());
+                let occluders = Occluders::for_path(&w, ray.origin);
+                skipping_paths +=
+                    (occluders.spheres.len() + occluders.planes.len() < w.spheres.lanes.len() + w.planes.len()) as u32;
+                for _ in 0..4 {
+                    let Some(hit) = w.intersect(&ray, f32::INFINITY) else { break };
+                    for light in &w.lights {
+                        let Some(sample) = light.sample(&w, &hit.surface, s.next_2d()) else { continue };
+                        let (shadow, t_max) = (&sample.shadow, sample.shadow_t_max);
+                        let everything = w.occluded(shadow, t_max);
+                        let skipping = occluders.blocks(&sample);
+                        samples += 1;
+                        blocked += everything as u32;
+                        if everything == skipping {
+                            continue;
+                        }
+                        assert!(everything, "{name}: skipping found a blocker testing everything did not");
+                        let own_triangle = sample
+                            .on_triangle
+                            .is_some_and(|t| intersect_triangle(shadow, &w.triangles[t as usize].0, t_max).is_some());
+                        let target = shadow.origin.as_dvec3() + shadow.direction.as_dvec3() * t_max as f64;
+                        assert!(
+                            own_triangle || on_a_wall(&w.walls, target),
+                            "{name}: a blocker skipped in the open, target {target}"
+                        );
+                    }
+                    let mut direction = uniform_sphere(s.next_2d());
+                    if direction.dot(hit.surface.normal) * (-ray.direction).dot(hit.surface.normal) < 0.0 {
+                        direction = -direction;
+                    }
+                    ray = Ray::new(hit.surface.spawn_ray(direction).origin, direction);
+                }
+            }
+            assert!(samples > 4000 && blocked > samples / 50, "{name}: {blocked} of {samples} blocked");
+            if name == "smallpt" || name.starts_with("cornell") {
+                assert!(skipping_paths > 3000, "{name}: only {skipping_paths} paths skip walls");
+            }
+        }
+    }
+}
