@@ -11,6 +11,7 @@ pub struct Triangle {
     /// A ball holding the triangle, for rejecting rays that pass far from it.
     bound_center: Vec3,
     bound_radius: f32,
+    area: f32,
 }
 
 impl Triangle {
@@ -20,10 +21,11 @@ impl Triangle {
         let n = (b64 - a64).cross(c64 - a64);
         let length = n.length();
         let normal = if length > 0.0 && length.is_finite() { (n / length).as_vec3() } else { Vec3::ZERO };
+        let area = (0.5 * length) as f32;
         // The ball about the centroid, measured from the centre as rounded to f32
         let bound_center = ((a64 + b64 + c64) / 3.0).as_vec3();
         let reach = [a64, b64, c64].map(|v| (v - bound_center.as_dvec3()).length()).into_iter().fold(0.0, f64::max);
-        Self { vertices: [a, b, c], normal, bound_center, bound_radius: (reach as f32).next_up() }
+        Self { vertices: [a, b, c], normal, bound_center, bound_radius: (reach as f32).next_up(), area }
     }
 
     pub fn is_degenerate(&self) -> bool {
@@ -31,8 +33,18 @@ impl Triangle {
     }
 
     pub fn area(&self) -> f32 {
-        let [a, b, c] = self.vertices;
-        0.5 * (b - a).cross(c - a).length()
+        self.area
+    }
+
+    /// Whether `other` lies in this triangle's plane, to within rounding.
+    pub fn holds_in_plane(&self, other: &Triangle) -> bool {
+        let (normal, a) = (self.normal.as_dvec3(), self.vertices[0].as_dvec3());
+        let scale = other.vertices.iter().chain(&self.vertices).map(|v| v.abs().max_element()).fold(0.0, f32::max);
+        !self.is_degenerate()
+            && other
+                .vertices
+                .iter()
+                .all(|v| normal.dot(v.as_dvec3() - a).abs() <= 4.0 * f32::EPSILON as f64 * scale as f64)
     }
 }
 
@@ -137,6 +149,20 @@ fn watertight(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<SurfaceHit> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn coplanar_triangles_far_from_the_origin() {
+        let at = Vec3::new(1.0e4, -3.0e3, 2.0e4);
+        let (u, v) = (Vec3::new(0.6, 0.8, 0.0), Vec3::new(0.0, 0.0, 1.0));
+        let quad = [at, at + u, at + u + v, at + v];
+        let a = Triangle::new(quad[0], quad[1], quad[2]);
+        let b = Triangle::new(quad[0], quad[2], quad[3]);
+        assert!(a.holds_in_plane(&b) && b.holds_in_plane(&a));
+        assert!((a.area() - 0.5).abs() < 1e-3 && (b.area() - 0.5).abs() < 1e-3);
+        // Lifted off the plane by 0.05 (25 ulps of 2e4): no longer in it
+        let lifted = Triangle::new(quad[0], quad[2], quad[3] + u.cross(v) * 0.05);
+        assert!(!a.holds_in_plane(&lifted));
+    }
 
     #[test]
     fn hits_inside_and_misses_outside() {

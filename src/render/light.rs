@@ -47,7 +47,7 @@ pub struct LightSample {
     /// The shadow ray and how far it may go.
     pub shadow: Ray,
     pub shadow_t_max: f32,
-    /// The triangle the sample lies on, which its shadow ray cannot cross.
+    /// The triangle the sample lies on: its shadow ray meets that plane only at its end.
     pub on_triangle: Option<u32>,
 }
 

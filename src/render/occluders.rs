@@ -4,8 +4,8 @@
 //!   ball or a half-space stays in it. So when such a wall also holds every
 //!   light's sample points (smallpt's six spheres of radius 1e5, the Cornell
 //!   box's five planes), the shadow rays of paths from inside skip it.
-//! - The light's own triangle: a shadow ray ends on the triangle's plane
-//!   and meets that plane nowhere else.
+//! - Triangles in the plane of the light's triangle (its own, the other half
+//!   of a quad): a shadow ray ends in that plane and meets it nowhere else.
 
 use glam::{DVec3, Vec3};
 
@@ -166,10 +166,12 @@ impl<'w> Occluders<'w> {
     #[inline]
     pub fn blocks(&self, sample: &LightSample) -> bool {
         let (ray, t_max) = (&sample.shadow, sample.shadow_t_max);
+        let world = self.world;
+        let light_plane = sample.on_triangle.map(|t| world.light_plane[t as usize]);
         self.spheres.any_hit(ray, t_max)
             || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
-            || self.world.triangles.iter().enumerate().any(|(i, (triangle, _))| {
-                sample.on_triangle != Some(i as u32) && intersect_triangle(ray, triangle, t_max).is_some()
+            || world.triangles.iter().zip(&world.light_plane).any(|((triangle, _), plane)| {
+                light_plane != Some(*plane) && intersect_triangle(ray, triangle, t_max).is_some()
             })
     }
 }
@@ -212,6 +214,7 @@ mod tests {
         assert_eq!((w.walls.regions.len(), w.walls.spheres.len(), w.walls.planes.len()), (6, 3, 0));
         let w = world(&preset("cornell"));
         assert_eq!((w.walls.regions.len(), w.walls.spheres.len(), w.walls.planes.len()), (5, 2, 0));
+        assert_eq!(w.light_plane, [0, 0], "the panel's two halves share a plane");
     }
 
     /// A wall must hold every light: a point light above smallpt's ceiling
@@ -251,7 +254,7 @@ mod tests {
     /// and through smallpt and the Cornell box with a point light outside
     /// one wall. Skipping may lose only blockers that rounding put at the
     /// very end of a segment: a light sample on a wall's surface (smallpt's
-    /// light is cut at the ceiling), or one a hair behind its own triangle.
+    /// light is cut at the ceiling), or one a hair behind its own plane.
     #[test]
     fn skipping_agrees_with_testing_everything() {
         let mut scenes: Vec<(String, Scene)> =
@@ -284,12 +287,15 @@ mod tests {
                             continue;
                         }
                         assert!(everything, "{name}: skipping found a blocker testing everything did not");
-                        let own_triangle = sample
-                            .on_triangle
-                            .is_some_and(|t| intersect_triangle(shadow, &w.triangles[t as usize].0, t_max).is_some());
+                        let own_plane = sample.on_triangle.is_some_and(|t| {
+                            w.triangles.iter().zip(&w.light_plane).any(|((triangle, _), plane)| {
+                                *plane == w.light_plane[t as usize]
+                                    && intersect_triangle(shadow, triangle, t_max).is_some()
+                            })
+                        });
                         let target = shadow.origin.as_dvec3() + shadow.direction.as_dvec3() * t_max as f64;
                         assert!(
-                            own_triangle || on_a_wall(&w.walls, target),
+                            own_plane || on_a_wall(&w.walls, target),
                             "{name}: a blocker skipped in the open, target {target}"
                         );
                     }

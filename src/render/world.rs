@@ -125,8 +125,11 @@ pub struct World {
     pub bounds_radius: f32,
     /// Per sphere, the cap that emits toward the scene (see `emitting_cap`).
     caps: Vec<EmitterCap>,
-    /// Spheres that shadow rays from inside them may skip (see `Occluders`).
+    /// Spheres and planes that shadow rays from inside may skip (see `Occluders`).
     pub(crate) walls: Walls,
+    /// Per triangle, the first light triangle whose plane holds it, if any
+    /// (`u32::MAX` if none): shadow rays toward a light skip its plane.
+    pub(crate) light_plane: Vec<u32>,
 }
 
 impl World {
@@ -145,6 +148,7 @@ impl World {
             bounds_radius: 0.0,
             caps: Vec::new(),
             walls: Walls::default(),
+            light_plane: Vec::new(),
         };
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for (index, object) in scene.objects.iter().enumerate() {
@@ -218,6 +222,21 @@ impl World {
                 }
             }
         }
+        let light_triangles: Vec<u32> = (world.lights.iter())
+            .filter_map(|light| match light {
+                LightSource::Area { object, .. } => match world.objects[*object as usize].shape {
+                    ShapeRef::Triangle(t) => Some(t),
+                    _ => None,
+                },
+                _ => None,
+            })
+            .collect();
+        world.light_plane = (world.triangles.iter())
+            .map(|(t, _)| {
+                let holds = |&j: &u32| world.triangles[j as usize].0.holds_in_plane(t);
+                light_triangles.iter().copied().find(holds).unwrap_or(u32::MAX)
+            })
+            .collect();
         world.caps = world.emitter_caps(None);
         world
     }
