@@ -251,8 +251,8 @@ mod tests {
     }
 
     /// Against testing everything, on random paths through every preset,
-    /// and through smallpt and the Cornell box with a point light outside
-    /// one wall. Skipping may lose only blockers that rounding put at the
+    /// through smallpt and the Cornell box with a point light outside one
+    /// wall, and through the Cornell box with a triangle under its panel. Skipping may lose only blockers that rounding put at the
     /// very end of a segment: a light sample on a wall's surface (smallpt's
     /// light is cut at the ceiling), or one a hair behind its own plane.
     #[test]
@@ -264,6 +264,18 @@ mod tests {
             scene.lights.push(point_light(outside));
             scenes.push((format!("{name} with a light outside"), scene));
         }
+        // A white triangle under the panel: a blocker that no skip may lose
+        let mut scene = preset("cornell");
+        scene.objects.push(crate::scene::Object {
+            name: "shade".into(),
+            shape: crate::scene::Shape::Triangle {
+                a: Vec3::new(-0.5, 1.6, -0.5),
+                b: Vec3::new(0.5, 1.6, -0.5),
+                c: Vec3::new(0.0, 1.6, 0.5),
+            },
+            material: "white".into(),
+        });
+        scenes.push(("cornell with a shade".into(), scene));
         for (name, scene) in &scenes {
             let w = world(scene);
             let camera = CameraModel::new(&scene.camera, 64, 48);
