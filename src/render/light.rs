@@ -51,6 +51,14 @@ pub struct LightSample {
     pub on_triangle: Option<u32>,
 }
 
+impl LightSample {
+    /// From a delta light: an infinite pdf, no surface under the sample.
+    #[inline]
+    fn delta(shadow: Ray, shadow_t_max: f32, value: Rgb) -> Self {
+        LightSample { wi: shadow.direction, value, pdf: f32::INFINITY, shadow, shadow_t_max, on_triangle: None }
+    }
+}
+
 /// The thesis' spot factor: 0 outside the cone, (Vp·Va)^σ inside.
 #[inline]
 pub fn spot_factor(axis: Vec3, light_to_point: Vec3, cos_cone: f32, exponent: f32) -> f32 {
@@ -77,15 +85,7 @@ impl LightSource {
             LightSource::Point { position, intensity, attenuation } => {
                 let (shadow, shadow_t_max) = at.spawn_ray_to(position, 0.0);
                 let d = (position - p).length();
-                let value = intensity * attenuation.factor(d);
-                Some(LightSample {
-                    wi: shadow.direction,
-                    value,
-                    pdf: f32::INFINITY,
-                    shadow,
-                    shadow_t_max,
-                    on_triangle: None,
-                })
+                Some(LightSample::delta(shadow, shadow_t_max, intensity * attenuation.factor(d)))
             }
             LightSource::Spot { position, direction, cos_cone, exponent, intensity, attenuation } => {
                 let (shadow, shadow_t_max) = at.spawn_ray_to(position, 0.0);
@@ -94,26 +94,10 @@ impl LightSource {
                 if factor == 0.0 {
                     return None;
                 }
-                let value = intensity * (attenuation.factor(d) * factor);
-                Some(LightSample {
-                    wi: shadow.direction,
-                    value,
-                    pdf: f32::INFINITY,
-                    shadow,
-                    shadow_t_max,
-                    on_triangle: None,
-                })
+                Some(LightSample::delta(shadow, shadow_t_max, intensity * (attenuation.factor(d) * factor)))
             }
             LightSource::Directional { direction, irradiance } => {
-                let shadow = at.spawn_ray(-direction);
-                Some(LightSample {
-                    wi: -direction,
-                    value: irradiance,
-                    pdf: f32::INFINITY,
-                    shadow,
-                    shadow_t_max: f32::INFINITY,
-                    on_triangle: None,
-                })
+                Some(LightSample::delta(at.spawn_ray(-direction), f32::INFINITY, irradiance))
             }
             LightSource::Area { object, radiance } => {
                 let (target, normal, error, pdf) = sample_area(world, object, p, u)?;
