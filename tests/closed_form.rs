@@ -19,7 +19,7 @@ fn trace(algorithm: Algorithm, world: &World, ray: &Ray, samples: u32) -> Vec3 {
     for s in 0..samples {
         let mut sampler = Sampler::new(1, s as u64, 7);
         sum += match algorithm {
-            Algorithm::Whitted => whitted::radiance(world, ray, 5, 1.0, &mut sampler, &mut counters),
+            Algorithm::Whitted => whitted::radiance(world, ray, 5, &mut sampler, &mut counters),
             _ => path::radiance(world, ray, 32, &mut sampler, &mut counters),
         };
     }

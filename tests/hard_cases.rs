@@ -97,7 +97,7 @@ fn case_03_distant_sphere_has_no_rings() {
     for y in 0..48 {
         for x in 0..48 {
             let ray = camera.pixel_ray(x as f32 + 0.5, y as f32 + 0.5);
-            let got = whitted::radiance(&world, &ray, 1, 1.0, &mut Sampler::new(0, 0, 0), &mut counters).x as f64;
+            let got = whitted::radiance(&world, &ray, 1, &mut Sampler::new(0, 0, 0), &mut counters).x as f64;
             let (o, d, c) = (ray.origin.as_dvec3(), ray.direction.as_dvec3(), center.as_dvec3());
             let f = o - c;
             let b = f.dot(d);

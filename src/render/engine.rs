@@ -447,7 +447,7 @@ impl FrameContext<'_> {
                 renderer.radiance(&ray, &mut sampler, counters, scratch)
             }
             _ if settings.algorithm == Algorithm::Whitted => {
-                whitted::radiance(&self.world, &ray, settings.max_depth.max(1), 1.0, &mut sampler, counters)
+                whitted::radiance(&self.world, &ray, settings.max_depth.max(1), &mut sampler, counters)
             }
             _ => path::radiance(&self.world, &ray, settings.max_depth, &mut sampler, counters),
         };

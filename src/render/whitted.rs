@@ -21,18 +21,13 @@ use crate::scene::{MaterialModel, Rgb};
 /// Below this path weight a reflection adds nothing visible.
 const MIN_WEIGHT: f32 = 1e-3;
 
-pub fn radiance(
-    world: &World,
-    ray: &Ray,
-    depth_left: u32,
-    weight: f32,
-    sampler: &mut Sampler,
-    counters: &mut Counters,
-) -> Rgb {
-    trace(Occluders::for_path(world, ray.origin), ray, depth_left, weight, sampler, counters)
+/// Radiance along a camera ray, recursing at most `max_depth` times.
+pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
+    trace(Occluders::for_path(world, ray.origin), ray, max_depth, 1.0, sampler, counters)
 }
 
-/// The recursion, for a path that started where `occluders` was made.
+/// The recursion, for a path that started where `occluders` was made;
+/// `weight` is what its result is multiplied by on the way to the camera.
 fn trace(
     occluders: Occluders,
     ray: &Ray,
