@@ -1,7 +1,7 @@
 //! GI Studio: global illumination with four light-transport algorithms on one
 //! engine. Layers depend one way: geometry → scene → render → analysis →
 //! (cli | app).
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 
 pub mod analysis;
 pub mod app;

@@ -55,6 +55,8 @@ pub struct Walls {
     /// The spheres and planes that are not walls.
     spheres: SphereLanes,
     planes: Vec<PlaneShape>,
+    /// Per sphere of the world, whether it is a wall.
+    pub(crate) is_wall_sphere: Vec<bool>,
 }
 
 impl Walls {
@@ -74,13 +76,16 @@ impl Walls {
         };
         let s = &world.spheres;
         let (mut regions, mut others) = (Vec::new(), Vec::new());
+        let mut is_wall_sphere = Vec::with_capacity(s.radius.len());
         for j in 0..s.radius.len() {
             let region = Region::Ball { center: s.center(j).as_dvec3(), radius: s.radius[j] as f64 };
-            if is_wall(&region, s.object[j]) {
+            let wall = is_wall(&region, s.object[j]);
+            if wall {
                 regions.push(region);
             } else {
                 others.push(j);
             }
+            is_wall_sphere.push(wall);
         }
         let mut planes = Vec::new();
         for plane in &world.planes {
@@ -99,7 +104,14 @@ impl Walls {
         }
         let centers: Vec<Vec3> = others.iter().map(|&j| s.center(j)).collect();
         let radii: Vec<f32> = others.iter().map(|&j| s.radius[j]).collect();
-        Walls { regions, spheres: SphereLanes::new(&centers, &radii), planes }
+        Walls { regions, spheres: SphereLanes::new(&centers, &radii), planes, is_wall_sphere }
+    }
+
+    /// Whether a path starting at `origin` is inside every wall (and there are walls).
+    #[inline]
+    pub(crate) fn hold(&self, origin: Vec3) -> bool {
+        let origin = origin.as_dvec3();
+        !self.regions.is_empty() && self.regions.iter().all(|region| region.holds_strictly(origin))
     }
 }
 
@@ -150,8 +162,7 @@ impl<'w> Occluders<'w> {
     #[inline]
     pub fn for_path(world: &'w World, origin: Vec3) -> Self {
         let walls = &world.walls;
-        let origin = origin.as_dvec3();
-        if !walls.regions.is_empty() && walls.regions.iter().all(|region| region.holds_strictly(origin)) {
+        if walls.hold(origin) {
             Occluders { world, spheres: &walls.spheres, planes: &walls.planes }
         } else {
             Occluders { world, spheres: &world.spheres.lanes, planes: &world.planes }

@@ -13,7 +13,7 @@ use crate::geometry::Ray;
 use crate::scene::Rgb;
 
 /// Bounces before Russian roulette may end a path.
-const ROULETTE_DEPTH: u32 = 3;
+pub(crate) const ROULETTE_DEPTH: u32 = 3;
 
 pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
     let occluders = Occluders::for_path(world, ray.origin);

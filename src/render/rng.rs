@@ -9,8 +9,8 @@ pub struct Sampler {
     state: u64,
 }
 
-#[inline]
-fn mix64(mut z: u64) -> u64 {
+#[inline(always)]
+pub(crate) fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
@@ -30,8 +30,18 @@ impl Sampler {
     /// splitmix64: one add and a mix per number, statistically solid.
     #[inline]
     pub fn next_u64(&mut self) -> u64 {
-        self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        self.state = Self::step(self.state);
         mix64(self.state)
+    }
+
+    /// The state after one draw (for streams kept in SIMD lanes).
+    #[inline(always)]
+    pub(crate) fn step(state: u64) -> u64 {
+        state.wrapping_add(0x9e37_79b9_7f4a_7c15)
+    }
+
+    pub(crate) fn state(&self) -> u64 {
+        self.state
     }
 
     /// Uniform in [0, 1): 24 random bits, so 1.0 is never returned.

@@ -1,0 +1,699 @@
+//! Path tracing eight paths at a time, for scenes made of spheres (smallpt's
+//! kind): each sphere is tested against eight rays in one SIMD pass, and the
+//! shading runs in the same lanes. A lane whose path ends takes the next
+//! sample, so lanes stay busy however long the paths are.
+//!
+//! It is `path::radiance` lane by lane, not an approximation of it: the
+//! same operations in the same order on the same random streams, so the
+//! image is bit for bit the scalar one (`tests/path_lanes.rs` checks it).
+//! Rare cases (a BSDF-sampled ray reaching a light, lights other than a
+//! sphere's cap) call the scalar code for that lane.
+
+use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_2, FRAC_PI_4, PI};
+
+use glam::{Vec2, Vec3};
+
+use super::lanes::{Rng8, F8, LANES, M8, V8};
+use super::light::{area_pdf, LightSource};
+use super::rng::Sampler;
+use super::sampling::power_heuristic;
+use super::world::{ShapeRef, World};
+use super::Counters;
+use crate::geometry::{gamma, Ray, SurfaceHit};
+use crate::scene::{MaterialModel, Rgb};
+
+/// Bounces before Russian roulette may end a path (as in `path`).
+const ROULETTE_DEPTH: u32 = super::path::ROULETTE_DEPTH;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Kind {
+    Lambert,
+    Mirror,
+    Glass,
+    Emissive,
+}
+
+/// One sphere with what shading needs of its material.
+#[derive(Clone, Copy, Debug)]
+struct SphereInfo {
+    center: Vec3,
+    radius: f32,
+    radius2: f32,
+    /// Bound on the error of points computed on it (as `sphere_hit` gives).
+    error: f32,
+    object: u32,
+    kind: Kind,
+    /// Albedo, tint or radiance.
+    color: Rgb,
+    ior: f32,
+    is_wall: bool,
+}
+
+/// A sphere light's emitting cap, as light sampling draws it; `None` for
+/// lights the scalar code samples lane by lane.
+#[derive(Clone, Copy, Debug)]
+struct CapLight {
+    center: Vec3,
+    radius: f32,
+    error: f32,
+    frame: [Vec3; 3],
+    one_minus_cos: f32,
+    area: f32,
+    radiance: Rgb,
+}
+
+impl CapLight {
+    const NONE: CapLight = CapLight {
+        center: Vec3::ZERO,
+        radius: 0.0,
+        error: 0.0,
+        frame: [Vec3::X, Vec3::Y, Vec3::Z],
+        one_minus_cos: 0.0,
+        area: 0.0,
+        radiance: Vec3::ZERO,
+    };
+}
+
+/// A world compiled for eight-lane path tracing.
+#[derive(Clone, Debug)]
+pub struct PathLanes {
+    spheres: Vec<SphereInfo>,
+    lights: Vec<Option<CapLight>>,
+    background: Rgb,
+}
+
+impl PathLanes {
+    /// For worlds of spheres only, with Lambert, mirror, glass and emissive
+    /// materials; None for anything else (the scalar tracer renders it).
+    pub fn new(world: &World) -> Option<Self> {
+        if world.spheres.radius.is_empty() || !world.planes.is_empty() || !world.triangles.is_empty() {
+            return None;
+        }
+        let s = &world.spheres;
+        let walls = &world.walls.is_wall_sphere;
+        let spheres = (0..s.radius.len())
+            .map(|i| {
+                let object = s.object[i];
+                let (center, radius) = (s.center(i), s.radius[i]);
+                let (kind, color, ior) = match world.materials[world.objects[object as usize].material as usize] {
+                    MaterialModel::Lambert { albedo } => (Kind::Lambert, albedo, 1.0),
+                    MaterialModel::Mirror { tint } => (Kind::Mirror, tint, 1.0),
+                    MaterialModel::Glass { ior, tint } => (Kind::Glass, tint, ior),
+                    MaterialModel::Emissive { radiance } => (Kind::Emissive, radiance, 1.0),
+                    _ => return None,
+                };
+                Some(SphereInfo {
+                    center,
+                    radius,
+                    radius2: radius * radius,
+                    error: gamma(6) * (center.abs().max_element() + radius),
+                    object,
+                    kind,
+                    color,
+                    ior,
+                    is_wall: walls.get(i).copied().unwrap_or(false),
+                })
+            })
+            .collect::<Option<Vec<_>>>()?;
+        let lights = (world.lights.iter())
+            .map(|light| match *light {
+                LightSource::Area { object, radiance } => match world.objects[object as usize].shape {
+                    ShapeRef::Sphere(i) => {
+                        let cap = world.emitting_cap(i as usize);
+                        let info = &spheres[i as usize];
+                        (!cap.is_whole()).then(|| CapLight {
+                            center: info.center,
+                            radius: info.radius,
+                            error: info.error,
+                            frame: [cap.frame.x, cap.frame.y, cap.frame.z],
+                            one_minus_cos: cap.one_minus_cos,
+                            area: cap.area(info.radius),
+                            radiance,
+                        })
+                    }
+                    _ => None,
+                },
+                _ => None,
+            })
+            .collect();
+        Some(PathLanes { spheres, lights, background: world.background })
+    }
+
+    /// The radiance of every camera sample in `paths`, into `out`.
+    pub fn radiance(
+        &self,
+        world: &World,
+        paths: &[(Ray, Sampler)],
+        max_depth: u32,
+        out: &mut [Rgb],
+        counters: &mut Counters,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, checked just above.
+            #[allow(unsafe_code)]
+            unsafe {
+                self.radiance_avx2(world, paths, max_depth, out, counters)
+            };
+            return;
+        }
+        self.radiance_lanes(world, paths, max_depth, out, counters);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn radiance_avx2(
+        &self,
+        world: &World,
+        paths: &[(Ray, Sampler)],
+        max_depth: u32,
+        out: &mut [Rgb],
+        counters: &mut Counters,
+    ) {
+        self.radiance_lanes(world, paths, max_depth, out, counters);
+    }
+
+    #[inline(always)]
+    fn radiance_lanes(
+        &self,
+        world: &World,
+        paths: &[(Ray, Sampler)],
+        max_depth: u32,
+        out: &mut [Rgb],
+        counters: &mut Counters,
+    ) {
+        let mut state = Lanes::new();
+        let mut next = 0;
+        loop {
+            // Idle lanes take the next sample
+            for lane in 0..LANES {
+                while !state.active.test(lane) && next < paths.len() {
+                    let (ray, sampler) = &paths[next];
+                    if max_depth == 0 {
+                        out[next] = Rgb::ZERO;
+                    } else {
+                        state.start(lane, next, ray, sampler, world.walls.hold(ray.origin));
+                    }
+                    next += 1;
+                }
+            }
+            if !state.active.any() {
+                return;
+            }
+            self.bounce(world, &mut state, max_depth, out, counters);
+        }
+    }
+
+    /// One bounce of every active path: `path::radiance`'s loop body.
+    #[inline(always)]
+    fn bounce(&self, world: &World, st: &mut Lanes, max_depth: u32, out: &mut [Rgb], counters: &mut Counters) {
+        let active = st.active;
+        counters.rays += active.count();
+        let (origin, direction) = (st.origin, st.direction);
+
+        // Nearest sphere, in index order: ties keep the first, as `SphereLanes::nearest`
+        let mut t_hit = F8::splat(f32::INFINITY);
+        let mut index = [0u32; LANES];
+        let mut near = M8::NONE;
+        for (k, sphere) in self.spheres.iter().enumerate() {
+            let (t, is_near) = roots(origin, direction, sphere.center, sphere.radius2, t_hit);
+            let closer = t.lt(t_hit);
+            t_hit = closer.select(t, t_hit);
+            index = closer.select_u32([k as u32; LANES], index);
+            near = closer.select_mask(is_near, near);
+        }
+        let found = active.and(t_hit.lt(F8::splat(f32::INFINITY)));
+        let missed = active.and_not(found);
+        if missed.any() {
+            let lit = st.radiance + st.throughput * V8::splat(self.background);
+            st.radiance = missed.select_v(lit, st.radiance);
+            st.finish(missed, out);
+        }
+        let alive = found;
+        if !alive.any() {
+            return;
+        }
+        let sphere: [&SphereInfo; LANES] = std::array::from_fn(|i| &self.spheres[index[i] as usize]);
+        let kind = |k: Kind| M8::from_fn(|i| sphere[i].kind == k).and(alive);
+        let (lambert, mirror, glass, emissive) =
+            (kind(Kind::Lambert), kind(Kind::Mirror), kind(Kind::Glass), kind(Kind::Emissive));
+        let color = V8::from_fn(|i| sphere[i].color);
+
+        // The hit, rebuilt from the closest approach as `sphere_hit` does
+        let center = V8::from_fn(|i| sphere[i].center);
+        let radius = F8::from_fn(|i| sphere[i].radius);
+        let error = F8::from_fn(|i| sphere[i].error);
+        let f = origin - center;
+        let closest = f - direction * f.dot(direction);
+        let half_chord = (radius * radius - closest.length_squared()).max(F8::splat(0.0)).sqrt();
+        let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
+        let length = from_center.length();
+        let normal = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
+        let point = center + normal * radius;
+        let wo = -direction;
+        let hit =
+            |i: usize| SurfaceHit { t: t_hit.0[i], point: point.lane(i), normal: normal.lane(i), error: error.0[i] };
+
+        // Emission reached by this ray, weighted against light sampling (rare: lane by lane)
+        let light_count = world.lights.len();
+        let pick_pdf = 1.0 / light_count.max(1) as f32;
+        let glowing = emissive.and(normal.dot(wo).gt(F8::splat(0.0))).and(color.nonzero());
+        for lane in (0..LANES).filter(|&i| glowing.test(i)) {
+            let object = sphere[lane].object;
+            let weight = match world.objects[object as usize].light {
+                Some(_) if !st.after_delta.test(lane) => power_heuristic(
+                    st.last_pdf.0[lane],
+                    pick_pdf * area_pdf(world, object, st.last_point.lane(lane), &hit(lane)),
+                ),
+                _ => 1.0,
+            };
+            let sum = st.radiance.lane(lane) + st.throughput.lane(lane) * sphere[lane].color * weight;
+            st.radiance.set_lane(lane, sum);
+        }
+
+        let facing = normal.dot(wo).lt(F8::splat(0.0)).select_v(-normal, normal);
+        let zero = F8::splat(0.0);
+
+        // Next-event estimation toward one light, chosen uniformly
+        if light_count > 0 && lambert.any() {
+            let u_pick = st.rng.next_f32(lambert);
+            let pick: [usize; LANES] =
+                std::array::from_fn(|i| ((u_pick.0[i] * light_count as f32) as usize).min(light_count - 1));
+            let u = (st.rng.next_f32(lambert), st.rng.next_f32(lambert));
+            let light = LightLanes::sample(self, world, &pick, lambert, point, normal, error, u, &hit);
+            // f = albedo / π where both directions are above the surface
+            let above = !light.wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
+            let f = color * F8::splat(FRAC_1_PI);
+            let shade = light.valid.and(above).and(f.nonzero());
+            counters.rays += shade.count();
+            if shade.any() {
+                let blocked = self.blocked(shade, st.inside_walls, light.origin, light.wi, light.t_max);
+                let lit = shade.and_not(blocked);
+                if lit.any() {
+                    let cos = light.wi.dot(facing);
+                    let bsdf_pdf = cos.max(zero) * FRAC_1_PI;
+                    let mis = power_heuristic8(pick_pdf * light.pdf, bsdf_pdf);
+                    let weight = light.delta.select(F8::splat(1.0), mis);
+                    let term = st.throughput * f * light.value * (cos * weight / pick_pdf);
+                    st.radiance = lit.select_v(st.radiance + term, st.radiance);
+                }
+            }
+        }
+
+        // Scattering: every live lane draws its three numbers
+        let u_lobe = st.rng.next_f32(alive);
+        let u = (st.rng.next_f32(alive), st.rng.next_f32(alive));
+        let mut wi = reflect(wo, facing);
+        let mut weight = color;
+        let mut pdf = F8::splat(1.0);
+        let mut scattered = mirror;
+        if lambert.any() {
+            let local = cosine_hemisphere(u);
+            let w = to_world(from_z(facing), local);
+            let cos = w.dot(facing);
+            let ok = lambert.and(cos.gt(zero));
+            wi = ok.select_v(w, wi);
+            pdf = ok.select(cos.max(zero) * FRAC_1_PI, pdf);
+            scattered = scattered.or(ok);
+        }
+        if glass.any() {
+            let ior = F8::from_fn(|i| sphere[i].ior);
+            let entering = wo.dot(normal).gt(zero);
+            let eta_i = entering.select(F8::splat(1.0), ior);
+            let eta_t = entering.select(ior, F8::splat(1.0));
+            let eta = eta_i / eta_t;
+            let cos_i = wo.dot(facing).map(|c| c.clamp(0.0, 1.0));
+            let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+            let total = sin2_t.ge(F8::splat(1.0));
+            let cos_t = (1.0 - sin2_t).sqrt();
+            let fresnel = total.select(F8::splat(1.0), fresnel_dielectric(cos_i, cos_t, eta_i, eta_t));
+            let refracted = (wo * -eta + facing * (eta * cos_i - cos_t)).normalize();
+            let through = glass.and_not(total).and(u_lobe.ge(fresnel));
+            let bounced = glass.and_not(through);
+            wi = through.select_v(refracted, wi);
+            weight = through.select_v(color * (eta * eta), weight);
+            pdf = through.select(1.0 - fresnel, bounced.select(fresnel, pdf));
+            scattered = scattered.or(glass);
+        }
+        let ended = alive.and_not(scattered);
+        st.finish(ended, out);
+        let go = scattered;
+        if !go.any() {
+            return;
+        }
+        st.throughput = go.select_v(st.throughput * weight, st.throughput);
+        st.after_delta = lambert.select_mask(M8::NONE, go.select_mask(M8::ALL, st.after_delta));
+        st.last_pdf = go.select(pdf, st.last_pdf);
+        st.last_point = go.select_v(point, st.last_point);
+
+        // Russian roulette after the first bounces
+        let roulette = M8::from_fn(|i| st.depth[i] + 1 >= ROULETTE_DEPTH).and(go);
+        let mut killed = M8::NONE;
+        if roulette.any() {
+            let survive = st.throughput.max_element().min(F8::splat(0.95));
+            let hopeless = roulette.and(survive.le(zero));
+            let draw = roulette.and_not(hopeless);
+            let u = st.rng.next_f32(draw);
+            killed = hopeless.or(draw.and(u.ge(survive)));
+            let kept = roulette.and_not(killed);
+            st.throughput = kept.select_v(st.throughput / survive, st.throughput);
+        }
+        st.finish(killed, out);
+        let go = go.and_not(killed);
+        st.origin = go.select_v(offset_ray_origin(point, error, normal, wi), st.origin);
+        st.direction = go.select_v(wi, st.direction);
+        let mut deep = M8::NONE;
+        for lane in (0..LANES).filter(|&i| go.test(i)) {
+            st.depth[lane] += 1;
+            deep.set(lane, st.depth[lane] >= max_depth);
+        }
+        st.finish(deep, out);
+    }
+
+    /// Lanes of `mask` whose shadow ray (origin, unit direction, t_max) is
+    /// blocked by a sphere; paths inside every wall skip the walls.
+    #[inline(always)]
+    fn blocked(&self, mask: M8, inside_walls: M8, origin: V8, direction: V8, t_max: F8) -> M8 {
+        let mut blocked = M8::NONE;
+        for sphere in &self.spheres {
+            let tested = if sphere.is_wall { mask.and_not(inside_walls) } else { mask };
+            if !tested.any() {
+                continue;
+            }
+            let (t, _) = roots(origin, direction, sphere.center, sphere.radius2, t_max);
+            blocked = blocked.or(tested.and(t.lt(t_max)));
+        }
+        blocked
+    }
+}
+
+/// Eight paths in flight.
+struct Lanes {
+    active: M8,
+    slot: [usize; LANES],
+    depth: [u32; LANES],
+    inside_walls: M8,
+    origin: V8,
+    direction: V8,
+    throughput: V8,
+    radiance: V8,
+    after_delta: M8,
+    last_pdf: F8,
+    last_point: V8,
+    rng: Rng8,
+}
+
+impl Lanes {
+    fn new() -> Self {
+        let zero = V8::splat(Vec3::ZERO);
+        Lanes {
+            active: M8::NONE,
+            slot: [0; LANES],
+            depth: [0; LANES],
+            inside_walls: M8::NONE,
+            origin: zero,
+            direction: zero,
+            throughput: zero,
+            radiance: zero,
+            after_delta: M8::NONE,
+            last_pdf: F8::splat(0.0),
+            last_point: zero,
+            rng: Rng8::new(),
+        }
+    }
+
+    #[inline(always)]
+    fn start(&mut self, lane: usize, slot: usize, ray: &Ray, sampler: &Sampler, inside_walls: bool) {
+        self.active.set(lane, true);
+        self.slot[lane] = slot;
+        self.depth[lane] = 0;
+        self.inside_walls.set(lane, inside_walls);
+        self.origin.set_lane(lane, ray.origin);
+        self.direction.set_lane(lane, ray.direction);
+        self.throughput.set_lane(lane, Rgb::ONE);
+        self.radiance.set_lane(lane, Rgb::ZERO);
+        self.after_delta.set(lane, true);
+        self.last_pdf.0[lane] = 0.0;
+        self.last_point.set_lane(lane, ray.origin);
+        self.rng.set_lane(lane, sampler);
+    }
+
+    /// Paths of `mask` are done: their radiance goes out, their lanes free up.
+    #[inline(always)]
+    fn finish(&mut self, mask: M8, out: &mut [Rgb]) {
+        for lane in (0..LANES).filter(|&i| mask.test(i)) {
+            out[self.slot[lane]] = self.radiance.lane(lane);
+            self.active.set(lane, false);
+        }
+    }
+}
+
+/// Light samples in eight lanes (only lanes of the mask are meaningful).
+struct LightLanes {
+    valid: M8,
+    delta: M8,
+    wi: V8,
+    /// Radiance over pdf (or the delta light's irradiance).
+    value: V8,
+    pdf: F8,
+    origin: V8,
+    t_max: F8,
+}
+
+impl LightLanes {
+    /// `LightSource::sample` for each lane's light: sphere caps in lanes,
+    /// other lights through the scalar code.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn sample(
+        lanes: &PathLanes,
+        world: &World,
+        pick: &[usize; LANES],
+        mask: M8,
+        point: V8,
+        normal: V8,
+        error: F8,
+        u: (F8, F8),
+        hit: &impl Fn(usize) -> SurfaceHit,
+    ) -> LightLanes {
+        let cap = |i: usize| lanes.lights[pick[i]].as_ref();
+        let cap_lanes = M8::from_fn(|i| cap(i).is_some()).and(mask);
+        let mut out = LightLanes {
+            valid: M8::NONE,
+            delta: M8::NONE,
+            wi: V8::splat(Vec3::Z),
+            value: V8::splat(Vec3::ZERO),
+            pdf: F8::splat(0.0),
+            origin: point,
+            t_max: F8::splat(0.0),
+        };
+        if cap_lanes.any() {
+            // Lanes without a cap compute on the first cap, unused
+            let first = lanes.lights.iter().flatten().next().unwrap_or(&CapLight::NONE);
+            let caps: [&CapLight; LANES] = std::array::from_fn(|i| cap(i).unwrap_or(first));
+            let center = V8::from_fn(|i| caps[i].center);
+            let radius = F8::from_fn(|i| caps[i].radius);
+            let light_error = F8::from_fn(|i| caps[i].error);
+            let frame = [0, 1, 2].map(|k| V8::from_fn(|i| caps[i].frame[k]));
+            let one_minus_cos = F8::from_fn(|i| caps[i].one_minus_cos);
+            let area = F8::from_fn(|i| caps[i].area);
+            let radiance = V8::from_fn(|i| caps[i].radiance);
+
+            // Uniform over the cap (`sample_area`)
+            let light_normal = to_world(frame, uniform_cone(u, one_minus_cos));
+            let target = center + light_normal * radius;
+            let pdf = solid_angle_pdf(point, target, light_normal, area);
+            // The shadow ray (`SurfaceHit::spawn_ray_to`)
+            let origin = offset_ray_origin(point, error, normal, target - point);
+            let to_target = target - origin;
+            let distance = to_target.length();
+            let wi = to_target / distance;
+            let margin = light_error.max(spawn_offset_scale(target)) * 4.0;
+            let t_max = (distance - margin).max(F8::splat(0.0));
+            // Emission is one-sided: the light's front must face the point
+            let faces = !light_normal.dot(-wi).le(F8::splat(0.0));
+            let valid = cap_lanes.and(pdf.gt(F8::splat(0.0))).and(faces);
+            out = LightLanes { valid, delta: M8::NONE, wi, value: radiance / pdf, pdf, origin, t_max };
+        }
+        for lane in (0..LANES).filter(|&i| mask.test(i) && cap(i).is_none()) {
+            let light = &world.lights[pick[lane]];
+            let u = Vec2::new(u.0 .0[lane], u.1 .0[lane]);
+            if let Some(sample) = light.sample(world, &hit(lane), u) {
+                out.valid.set(lane, true);
+                out.delta.set(lane, light.is_delta());
+                out.wi.set_lane(lane, sample.wi);
+                out.value.set_lane(lane, sample.value);
+                out.pdf.0[lane] = sample.pdf;
+                out.origin.set_lane(lane, sample.shadow.origin);
+                out.t_max.0[lane] = sample.shadow_t_max;
+            }
+        }
+        out
+    }
+}
+
+/// Per lane, the nearest root of the sphere in (0, t_max) or infinity, and
+/// whether it is the near one: `SphereLanes::group`'s arithmetic with the
+/// rays in the lanes.
+#[inline(always)]
+fn roots(origin: V8, direction: V8, center: Vec3, radius2: f32, t_max: F8) -> (F8, M8) {
+    let f = origin - V8::splat(center);
+    let b = f.dot(direction);
+    let l = f - direction * b;
+    let r2 = F8::splat(radius2);
+    let discriminant = r2 - l.length_squared();
+    let c = f.length_squared() - r2;
+    let zero = F8::splat(0.0);
+    let q = -b - discriminant.max_glam(zero).sqrt().copysign(b);
+    let t0 = c / q;
+    let (near, far) = (t0.min_glam(q), t0.max_glam(q));
+    let hits = discriminant.ge(zero);
+    let near_ok = hits.and(near.gt(zero)).and(near.lt(t_max));
+    let far_ok = hits.and(far.gt(zero)).and(far.lt(t_max));
+    let t = near_ok.select(near, far_ok.select(far, F8::splat(f32::INFINITY)));
+    (t, near_ok)
+}
+
+#[inline(always)]
+fn reflect(w: V8, n: V8) -> V8 {
+    n * (2.0 * w.dot(n)) - w
+}
+
+/// `power_heuristic` in lanes.
+#[inline(always)]
+fn power_heuristic8(pdf_f: F8, pdf_g: F8) -> F8 {
+    let (f, g) = (pdf_f * pdf_f, pdf_g * pdf_g);
+    let sum = f + g;
+    let degenerate = sum.eq(F8::splat(0.0)).or(!f.is_finite());
+    let fallback = pdf_f.map(|p| if p.is_infinite() { 1.0 } else { 0.0 });
+    degenerate.select(fallback, f / sum)
+}
+
+#[inline(always)]
+fn fresnel_dielectric(cos_i: F8, cos_t: F8, eta_i: F8, eta_t: F8) -> F8 {
+    let parallel = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
+    let perpendicular = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
+    0.5 * (parallel * parallel + perpendicular * perpendicular)
+}
+
+/// `Frame::from_z` in lanes: [x, y, z].
+#[inline(always)]
+fn from_z(z: V8) -> [V8; 3] {
+    let sign = z.z.map(|v| 1.0f32.copysign(v));
+    let a = -1.0 / (sign + z.z);
+    let b = z.x * z.y * a;
+    let x = V8 { x: 1.0 + sign * z.x * z.x * a, y: sign * b, z: -sign * z.x };
+    let y = V8 { x: b, y: sign + z.y * z.y * a, z: -z.y };
+    [x, y, z]
+}
+
+#[inline(always)]
+fn to_world(frame: [V8; 3], v: V8) -> V8 {
+    frame[0] * v.x + frame[1] * v.y + frame[2] * v.z
+}
+
+/// `sampling::sin_cos` in lanes.
+#[inline(always)]
+fn sin_cos(x: F8) -> (F8, F8) {
+    const PI_2_HI: f32 = 1.570_312_5;
+    const PI_2_MID: f32 = 4.837_513e-4;
+    const PI_2_LO: f32 = 7.549_79e-8;
+    let k: [i32; LANES] = std::array::from_fn(|i| (x.0[i] * FRAC_2_PI + 0.5f32.copysign(x.0[i])) as i32);
+    let quadrant = F8::from_fn(|i| k[i] as f32);
+    let r = ((x - quadrant * PI_2_HI) - quadrant * PI_2_MID) - quadrant * PI_2_LO;
+    let r2 = r * r;
+    let sin = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));
+    let cos = 1.0 - 0.5 * r2 + r2 * r2 * (4.166_664_6e-2 + r2 * (-1.388_731_6e-3 + r2 * 2.443_315_7e-5));
+    let swap = M8::from_fn(|i| k[i] & 1 != 0);
+    let sin_negative = M8::from_fn(|i| k[i] & 2 != 0);
+    let cos_negative = M8::from_fn(|i| (k[i] + 1) & 2 != 0);
+    let (s, c) = (swap.select(cos, sin), swap.select(sin, cos));
+    (sin_negative.select(-s, s), cos_negative.select(-c, c))
+}
+
+/// `sampling::cosine_hemisphere` (through the concentric disc) in lanes.
+#[inline(always)]
+fn cosine_hemisphere(u: (F8, F8)) -> V8 {
+    let (ox, oy) = (2.0 * u.0 - 1.0, 2.0 * u.1 - 1.0);
+    let zero = F8::splat(0.0);
+    let centre = ox.eq(zero).and(oy.eq(zero));
+    let wide = ox.abs().gt(oy.abs());
+    let r = wide.select(ox, oy);
+    let theta = wide.select(FRAC_PI_4 * (oy / ox), FRAC_PI_2 - FRAC_PI_4 * (ox / oy));
+    let (sin, cos) = sin_cos(theta);
+    let dx = centre.select(zero, r * cos);
+    let dy = centre.select(zero, r * sin);
+    let z = (1.0 - (dx * dx + dy * dy)).max(zero).sqrt();
+    V8 { x: dx, y: dy, z }
+}
+
+/// `sampling::uniform_cone` in lanes.
+#[inline(always)]
+fn uniform_cone(u: (F8, F8), one_minus_cos_max: F8) -> V8 {
+    let one_minus_cos = u.0 * one_minus_cos_max;
+    let cos_theta = 1.0 - one_minus_cos;
+    let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(F8::splat(0.0)).sqrt();
+    let (sin, cos) = sin_cos(2.0 * PI * u.1);
+    V8 { x: sin_theta * cos, y: sin_theta * sin, z: cos_theta }
+}
+
+/// `light::solid_angle_pdf` in lanes.
+#[inline(always)]
+fn solid_angle_pdf(p: V8, point: V8, normal: V8, area: F8) -> F8 {
+    let to_light = point - p;
+    let distance2 = to_light.length_squared();
+    let cos_light = normal.dot(-to_light) / distance2.sqrt();
+    cos_light.gt(F8::splat(0.0)).select(distance2 / (cos_light * area), F8::splat(0.0))
+}
+
+/// `geometry::ray::spawn_offset_scale` in lanes.
+#[inline(always)]
+fn spawn_offset_scale(p: V8) -> F8 {
+    let m = p.abs().max_element().max(F8::splat(f32::MIN_POSITIVE));
+    let ulp = m.map(|m| f32::from_bits((m.to_bits() & 0x7f80_0000).saturating_sub(23 << 23)).max(f32::from_bits(1)));
+    ulp * 256.0
+}
+
+/// `geometry::offset_ray_origin` in lanes.
+#[inline(always)]
+fn offset_ray_origin(point: V8, error: F8, normal: V8, direction: V8) -> V8 {
+    let distance = error * normal.abs().element_sum() + spawn_offset_scale(point);
+    let offset = direction.dot(normal).lt(F8::splat(0.0)).select_v(-normal * distance, normal * distance);
+    point + offset
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::camera::CameraModel;
+
+    /// The portable build of the lanes (the one CPUs without AVX2 run) gives
+    /// the scalar tracer's samples too; `tests/path_lanes.rs` covers the
+    /// dispatched one.
+    #[test]
+    fn portable_lanes_match_the_scalar_tracer() {
+        let scene = crate::scene::presets::preset("smallpt").and_then(Result::ok).expect("smallpt preset");
+        let mut world = World::new(&scene);
+        let camera = CameraModel::new(&scene.camera, 24, 18);
+        let points = world.visible_points(&camera, 24, 18);
+        world.cover(&points, &camera);
+        let paths: Vec<(Ray, Sampler)> = (0..24 * 18)
+            .map(|pixel| {
+                let mut sampler = Sampler::new(pixel, 0, 3);
+                let film = Vec2::new((pixel % 24) as f32, (pixel / 24) as f32) + sampler.next_2d();
+                (camera.generate_ray(film, sampler.next_2d()), sampler)
+            })
+            .collect();
+        let lanes = PathLanes::new(&world).expect("spheres only");
+        let mut got = vec![Rgb::splat(-1.0); paths.len()];
+        lanes.radiance_lanes(&world, &paths, 32, &mut got, &mut Counters::default());
+        let mut lit = 0;
+        for ((ray, sampler), got) in paths.iter().zip(&got) {
+            let expected =
+                crate::render::path::radiance(&world, ray, 32, &mut sampler.clone(), &mut Counters::default());
+            assert_eq!(expected.to_array().map(f32::to_bits), got.to_array().map(f32::to_bits));
+            lit += (expected.max_element() > 0.0) as usize;
+        }
+        assert!(lit > 200, "{lit} samples carried light");
+    }
+}

@@ -1,0 +1,111 @@
+//! Eight-lane path tracing is `path::radiance` lane by lane: the same
+//! samples give the same radiance, bit for bit, whatever the lane a path
+//! lands in and however long its neighbours live.
+
+use gi_studio::geometry::Ray;
+use gi_studio::render::camera::CameraModel;
+use gi_studio::render::path;
+use gi_studio::render::path_lanes::PathLanes;
+use gi_studio::render::rng::Sampler;
+use gi_studio::render::world::World;
+use gi_studio::render::Counters;
+use gi_studio::scene::{presets, Attenuation, Light, LightKind, Rgb, Scene};
+use glam::Vec3;
+
+fn light(kind: LightKind, intensity: f32) -> Light {
+    Light { name: "extra".into(), kind, color: Rgb::ONE, intensity, attenuation: Attenuation::default(), enabled: true }
+}
+
+fn preset(name: &str) -> Scene {
+    presets::preset(name).and_then(Result::ok).expect("preset")
+}
+
+fn world(scene: &Scene, width: u32, height: u32) -> (World, CameraModel) {
+    let mut world = World::new(scene);
+    let camera = CameraModel::new(&scene.camera, width, height);
+    let points = world.visible_points(&camera, width, height);
+    world.cover(&points, &camera);
+    (world, camera)
+}
+
+/// Every pixel's camera sample of one pass, as the engine draws them.
+fn camera_samples(camera: &CameraModel, width: u32, height: u32, pass: u64, seed: u64) -> Vec<(Ray, Sampler)> {
+    (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let mut sampler = Sampler::new(y as u64 * width as u64 + x as u64, pass, seed);
+            let film = glam::Vec2::new(x as f32, y as f32) + sampler.next_2d();
+            (camera.generate_ray(film, sampler.next_2d()), sampler)
+        })
+        .collect()
+}
+
+/// Lanes against the scalar tracer over `passes` passes; returns how many
+/// samples carried light (so a test cannot pass on a black image).
+fn assert_lanes_match_scalar(scene: &Scene, max_depth: u32, passes: u64) -> usize {
+    let (width, height) = (40, 30);
+    let (world, camera) = world(scene, width, height);
+    let lanes = PathLanes::new(&world).expect("a scene of spheres");
+    let mut lit = 0;
+    for pass in 0..passes {
+        let samples = camera_samples(&camera, width, height, pass, 7);
+        let mut scalar_counters = Counters::default();
+        let expected: Vec<Rgb> = (samples.iter())
+            .map(|(ray, sampler)| path::radiance(&world, ray, max_depth, &mut sampler.clone(), &mut scalar_counters))
+            .collect();
+        let mut got = vec![Rgb::splat(-1.0); samples.len()];
+        let mut lane_counters = Counters::default();
+        lanes.radiance(&world, &samples, max_depth, &mut got, &mut lane_counters);
+        for (i, (e, g)) in expected.iter().zip(&got).enumerate() {
+            let bits = |v: &Rgb| v.to_array().map(f32::to_bits);
+            assert_eq!(bits(e), bits(g), "sample {i} of pass {pass}: scalar {e} vs lanes {g}");
+        }
+        assert_eq!(scalar_counters.rays, lane_counters.rays, "rays traced in pass {pass}");
+        lit += expected.iter().filter(|v| v.max_element() > 0.0).count();
+    }
+    lit
+}
+
+#[test]
+fn smallpt_bit_for_bit() {
+    let lit = assert_lanes_match_scalar(&preset("smallpt"), 32, 3);
+    assert!(lit > 3000, "only {lit} samples carried light");
+}
+
+#[test]
+fn short_paths_end_at_the_depth_cap() {
+    for depth in [0, 1, 2, 4] {
+        assert_lanes_match_scalar(&preset("smallpt"), depth, 1);
+    }
+}
+
+/// A second light of each other kind (lit lane by lane through the scalar
+/// code), a whole-sphere light in the open, and a light outside the walls.
+#[test]
+fn other_lights_bit_for_bit() {
+    let mut scene = preset("smallpt");
+    scene.lights.push(light(LightKind::Point { position: Vec3::new(30.0, 60.0, 90.0) }, 2000.0));
+    let spot = LightKind::Spot {
+        position: Vec3::new(70.0, 70.0, 60.0),
+        direction: Vec3::new(0.0, -1.0, 0.2),
+        cone_angle_degrees: 30.0,
+        falloff_exponent: 4.0,
+    };
+    scene.lights.push(light(spot, 3000.0));
+    // A small glowing ball inside the room: sampled as a whole sphere
+    let mut glow = scene.objects[8].clone();
+    glow.name = "glow".into();
+    glow.shape = gi_studio::scene::Shape::Sphere { center: Vec3::new(60.0, 40.0, 100.0), radius: 4.0 };
+    scene.objects.push(glow);
+    assert_lanes_match_scalar(&scene, 32, 2);
+    scene.lights.push(light(LightKind::Directional { direction: Vec3::new(0.1, -1.0, 0.3) }, 1.0));
+    assert_lanes_match_scalar(&scene, 32, 1);
+}
+
+#[test]
+fn only_scenes_of_spheres_take_lanes() {
+    let (cornell, _) = world(&preset("cornell"), 8, 6);
+    assert!(PathLanes::new(&cornell).is_none());
+    let (smallpt, _) = world(&preset("smallpt"), 8, 6);
+    assert!(PathLanes::new(&smallpt).is_some());
+}
