@@ -224,11 +224,6 @@ impl M8 {
     }
 
     #[inline(always)]
-    pub fn select_u32(self, a: [u32; LANES], b: [u32; LANES]) -> [u32; LANES] {
-        from_fn(|i| (self.0[i] as u32 & a[i]) | (!self.0[i] as u32 & b[i]))
-    }
-
-    #[inline(always)]
     pub fn select_v(self, a: V8, b: V8) -> V8 {
         V8 { x: self.select(a.x, b.x), y: self.select(a.y, b.y), z: self.select(a.z, b.z) }
     }

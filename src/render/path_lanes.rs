@@ -16,7 +16,7 @@ use glam::{Vec2, Vec3};
 use super::lanes::{Rng8, F8, LANES, M8, V8};
 use super::light::{area_pdf, LightSource};
 use super::rng::Sampler;
-use super::sampling::power_heuristic;
+use super::sampling::{power_heuristic, ROUND_BY_ADDING};
 use super::world::{ShapeRef, World};
 use super::Counters;
 use crate::geometry::{gamma, Ray, SurfaceHit};
@@ -213,13 +213,14 @@ impl PathLanes {
 
         // Nearest sphere, in index order: ties keep the first, as `SphereLanes::nearest`
         let mut t_hit = F8::splat(f32::INFINITY);
-        let mut index = [0u32; LANES];
+        // The index in a float lane: one blend per sphere
+        let mut index = F8::splat(0.0);
         let mut near = M8::NONE;
         for (k, sphere) in self.spheres.iter().enumerate() {
             let (t, is_near) = roots(origin, direction, sphere.center, sphere.radius2, t_hit);
             let closer = t.lt(t_hit);
             t_hit = closer.select(t, t_hit);
-            index = closer.select_u32([k as u32; LANES], index);
+            index = closer.select(F8::splat(k as f32), index);
             near = closer.select_mask(is_near, near);
         }
         let found = active.and(t_hit.lt(F8::splat(f32::INFINITY)));
@@ -233,7 +234,7 @@ impl PathLanes {
         if !alive.any() {
             return;
         }
-        let sphere: [&SphereInfo; LANES] = std::array::from_fn(|i| &self.spheres[index[i] as usize]);
+        let sphere: [&SphereInfo; LANES] = std::array::from_fn(|i| &self.spheres[index.0[i] as usize]);
         let kind = |k: Kind| M8::from_fn(|i| sphere[i].kind == k).and(alive);
         let (lambert, mirror, glass, emissive) =
             (kind(Kind::Lambert), kind(Kind::Mirror), kind(Kind::Glass), kind(Kind::Emissive));
@@ -277,8 +278,11 @@ impl PathLanes {
         // Next-event estimation toward one light, chosen uniformly
         if light_count > 0 && lambert.any() {
             let u_pick = st.rng.next_f32(lambert);
-            let pick: [usize; LANES] =
-                std::array::from_fn(|i| ((u_pick.0[i] * light_count as f32) as usize).min(light_count - 1));
+            let pick: [usize; LANES] = if light_count == 1 {
+                [0; LANES]
+            } else {
+                std::array::from_fn(|i| ((u_pick.0[i] * light_count as f32) as usize).min(light_count - 1))
+            };
             let u = (st.rng.next_f32(lambert), st.rng.next_f32(lambert));
             let light = LightLanes::sample(self, world, &pick, lambert, point, normal, error, u, &hit);
             // f = albedo / π where both directions are above the surface
@@ -494,7 +498,11 @@ impl LightLanes {
             let center = V8::from_fn(|i| caps[i].center);
             let radius = F8::from_fn(|i| caps[i].radius);
             let light_error = F8::from_fn(|i| caps[i].error);
-            let frame = [0, 1, 2].map(|k| V8::from_fn(|i| caps[i].frame[k]));
+            let frame = [
+                V8::from_fn(|i| caps[i].frame[0]),
+                V8::from_fn(|i| caps[i].frame[1]),
+                V8::from_fn(|i| caps[i].frame[2]),
+            ];
             let one_minus_cos = F8::from_fn(|i| caps[i].one_minus_cos);
             let area = F8::from_fn(|i| caps[i].area);
             let radiance = V8::from_fn(|i| caps[i].radiance);
@@ -598,8 +606,9 @@ fn sin_cos(x: F8) -> (F8, F8) {
     const PI_2_HI: f32 = 1.570_312_5;
     const PI_2_MID: f32 = 4.837_513e-4;
     const PI_2_LO: f32 = 7.549_79e-8;
-    let k: [i32; LANES] = std::array::from_fn(|i| (x.0[i] * FRAC_2_PI + 0.5f32.copysign(x.0[i])) as i32);
-    let quadrant = F8::from_fn(|i| k[i] as f32);
+    let shifted = x * FRAC_2_PI + ROUND_BY_ADDING;
+    let quadrant = shifted - ROUND_BY_ADDING;
+    let k: [u32; LANES] = shifted.0.map(f32::to_bits);
     let r = ((x - quadrant * PI_2_HI) - quadrant * PI_2_MID) - quadrant * PI_2_LO;
     let r2 = r * r;
     let sin = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));

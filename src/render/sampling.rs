@@ -4,6 +4,9 @@ use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_2, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
+/// 1.5·2²³: a float this size has unit spacing, so adding it rounds to an integer.
+pub(crate) const ROUND_BY_ADDING: f32 = 12_582_912.0;
+
 /// sin x and cos x together, inline: the warps below call them once per
 /// sample, and libm's out-of-line `sincosf` was 5% of path tracing. Reduced
 /// to |r| ≤ π/4 by quadrant (π/2 split in three, Cody–Waite, so r stays exact
@@ -14,10 +17,13 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
     const PI_2_HI: f32 = 1.570_312_5;
     const PI_2_MID: f32 = 4.837_513e-4;
     const PI_2_LO: f32 = 7.549_79e-8;
-    // Round to nearest through an integer: `f32::round` is a libm call
-    // without SSE4.1
-    let k = (x * FRAC_2_PI + 0.5f32.copysign(x)) as i32;
-    let quadrant = k as f32;
+    // Round to nearest by adding 1.5·2²³: the sum's last mantissa bits are
+    // the quadrant (mod 4, negatives included). No float-to-int conversion:
+    // `f32::round` is a libm call without SSE4.1, and the saturating `as i32`
+    // does not vectorise for `path_lanes`. Good for |x| < 2²¹.
+    let shifted = x * FRAC_2_PI + ROUND_BY_ADDING;
+    let quadrant = shifted - ROUND_BY_ADDING;
+    let k = shifted.to_bits();
     let r = ((x - quadrant * PI_2_HI) - quadrant * PI_2_MID) - quadrant * PI_2_LO;
     let r2 = r * r;
     let sin = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));
