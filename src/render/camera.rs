@@ -69,6 +69,11 @@ impl CameraModel {
         Ray::new(origin, direction)
     }
 
+    /// Whether rays start across a lens (and so need a lens sample).
+    pub fn has_lens(&self) -> bool {
+        self.aperture_radius > 0.0
+    }
+
     /// Film position (pixels) where a world point appears, if in front.
     pub fn project(&self, point: Vec3) -> Option<Vec2> {
         let v = point - self.position;

@@ -425,7 +425,9 @@ impl FrameContext<'_> {
         let pixel = y as u64 * self.settings.width as u64 + x as u64;
         let mut sampler = Sampler::new(pixel, sample, self.settings.seed);
         let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-        let ray = self.camera.generate_ray(film, sampler.next_2d());
+        // A pinhole needs no lens sample: its stream keeps two numbers
+        let lens = if self.camera.has_lens() { sampler.next_2d() } else { Vec2::ZERO };
+        let ray = self.camera.generate_ray(film, lens);
         (ray, sampler)
     }
 

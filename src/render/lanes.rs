@@ -237,6 +237,24 @@ impl std::ops::Not for M8 {
     }
 }
 
+/// Eight counters (path depths).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(32))]
+pub struct Count8(pub [u32; LANES]);
+
+impl Count8 {
+    #[inline(always)]
+    pub fn ge(self, bound: u32) -> M8 {
+        M8(from_fn(|i| -((self.0[i] >= bound) as i32)))
+    }
+
+    /// One more in the lanes of `mask`.
+    #[inline(always)]
+    pub fn count_in(self, mask: M8) -> Count8 {
+        Count8(from_fn(|i| self.0[i].wrapping_sub(mask.0[i] as u32)))
+    }
+}
+
 /// Eight 3-vectors (points, directions or colours), as glam computes them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct V8 {

@@ -21,20 +21,34 @@ enum Region {
     Ball {
         center: DVec3,
         radius: f64,
+        /// The same ball in f32, with squared distances below which a point
+        /// is surely inside and above which surely outside (f32's error in
+        /// |p − c|² is under 6 ulps; the margin is 16).
+        center_f32: Vec3,
+        surely_in2: f32,
+        surely_out2: f32,
     },
     /// `normal · p > offset`: the side the camera is on.
-    HalfSpace {
-        normal: DVec3,
-        offset: f64,
-    },
+    HalfSpace { normal: DVec3, offset: f64 },
 }
 
 impl Region {
+    fn ball(center: Vec3, radius: f32) -> Self {
+        let radius2 = radius as f64 * radius as f64;
+        Region::Ball {
+            center: center.as_dvec3(),
+            radius: radius as f64,
+            center_f32: center,
+            surely_in2: (radius2 * (1.0 - 1e-6)) as f32,
+            surely_out2: (radius2 * (1.0 + 1e-6)) as f32,
+        }
+    }
+
     /// Whether the ball (`center`, `reach`) lies in the region, touching
     /// its boundary at most.
     fn holds(&self, center: DVec3, reach: f64) -> bool {
         match *self {
-            Region::Ball { center: c, radius } => (center - c).length() + reach <= radius,
+            Region::Ball { center: c, radius, .. } => (center - c).length() + reach <= radius,
             Region::HalfSpace { normal, offset } => normal.dot(center) - offset >= reach,
         }
     }
@@ -42,9 +56,24 @@ impl Region {
     /// Strictly inside: where a path may start.
     fn holds_strictly(&self, p: DVec3) -> bool {
         match *self {
-            Region::Ball { center, radius } => (p - center).length_squared() < radius * radius,
+            Region::Ball { center, radius, .. } => (p - center).length_squared() < radius * radius,
             Region::HalfSpace { normal, offset } => normal.dot(p) > offset,
         }
+    }
+
+    /// `holds_strictly` for an f32 point, in f32 unless it is too close to call.
+    #[inline]
+    fn holds_strictly_f32(&self, p: Vec3) -> bool {
+        if let Region::Ball { center_f32, surely_in2, surely_out2, .. } = *self {
+            let distance2 = (p - center_f32).length_squared();
+            if distance2 < surely_in2 {
+                return true;
+            }
+            if distance2 > surely_out2 {
+                return false;
+            }
+        }
+        self.holds_strictly(p.as_dvec3())
     }
 }
 
@@ -78,7 +107,7 @@ impl Walls {
         let (mut regions, mut others) = (Vec::new(), Vec::new());
         let mut is_wall_sphere = Vec::with_capacity(s.radius.len());
         for j in 0..s.radius.len() {
-            let region = Region::Ball { center: s.center(j).as_dvec3(), radius: s.radius[j] as f64 };
+            let region = Region::ball(s.center(j), s.radius[j]);
             let wall = is_wall(&region, s.object[j]);
             if wall {
                 regions.push(region);
@@ -110,8 +139,7 @@ impl Walls {
     /// Whether a path starting at `origin` is inside every wall (and there are walls).
     #[inline]
     pub(crate) fn hold(&self, origin: Vec3) -> bool {
-        let origin = origin.as_dvec3();
-        !self.regions.is_empty() && self.regions.iter().all(|region| region.holds_strictly(origin))
+        !self.regions.is_empty() && self.regions.iter().all(|region| region.holds_strictly_f32(origin))
     }
 }
 
@@ -253,10 +281,33 @@ mod tests {
         assert_eq!(Occluders::for_path(&w, Vec3::new(50.0, 82.0, 150.0)).spheres.len(), 9);
     }
 
+    /// The f32 shortcut answers as f64 does, on points within a few ulps of
+    /// the surface of smallpt's radius-1e5 walls and far from it.
+    #[test]
+    fn the_f32_inside_test_agrees_with_f64() {
+        let w = world(&preset("smallpt"));
+        let mut s = Sampler::new(1, 2, 3);
+        let (mut near_in, mut near_out) = (0, 0);
+        for region in &w.walls.regions {
+            let Region::Ball { center_f32, radius, .. } = *region else { continue };
+            for _ in 0..20_000 {
+                // Distances from the surface from 1e-3 ulps to 1e4 units, either side
+                let offset = (10.0f64).powf(-5.0 + 9.0 * s.next_f32() as f64) * (2.0 * s.next_f32() as f64 - 1.0);
+                let p = (center_f32.as_dvec3() + uniform_sphere(s.next_2d()).as_dvec3() * (radius + offset)).as_vec3();
+                let exact = region.holds_strictly(p.as_dvec3());
+                assert_eq!(region.holds_strictly_f32(p), exact, "{p} at {offset} from the surface");
+                if offset.abs() < 0.1 {
+                    (near_in, near_out) = (near_in + exact as u32, near_out + !exact as u32);
+                }
+            }
+        }
+        assert!(near_in > 1000 && near_out > 1000, "{near_in} in, {near_out} out near the surface");
+    }
+
     /// Whether `p` lies within rounding of a wall's surface.
     fn on_a_wall(walls: &Walls, p: DVec3) -> bool {
         walls.regions.iter().any(|region| match *region {
-            Region::Ball { center, radius } => ((p - center).length() - radius).abs() <= 1e-7 * radius + 1e-4,
+            Region::Ball { center, radius, .. } => ((p - center).length() - radius).abs() <= 1e-7 * radius + 1e-4,
             Region::HalfSpace { normal, offset } => (normal.dot(p) - offset).abs() <= 1e-6 * (1.0 + offset.abs()),
         })
     }

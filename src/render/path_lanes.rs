@@ -9,11 +9,11 @@
 //! Rare cases (a BSDF-sampled ray reaching a light, lights other than a
 //! sphere's cap) call the scalar code for that lane.
 
-use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_2, FRAC_PI_4, PI};
+use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
-use super::lanes::{Rng8, F8, LANES, M8, V8};
+use super::lanes::{Count8, Rng8, F8, LANES, M8, V8};
 use super::light::{area_pdf, LightSource};
 use super::rng::Sampler;
 use super::sampling::{power_heuristic, ROUND_BY_ADDING};
@@ -33,6 +33,13 @@ enum Kind {
     Emissive,
 }
 
+impl Kind {
+    /// The kind as a float, for comparing eight at a time.
+    fn code(self) -> F8 {
+        F8::splat(self as u8 as f32)
+    }
+}
+
 /// One sphere with what shading needs of its material.
 #[derive(Clone, Copy, Debug)]
 struct SphereInfo {
@@ -42,11 +49,11 @@ struct SphereInfo {
     /// Bound on the error of points computed on it (as `sphere_hit` gives).
     error: f32,
     object: u32,
-    kind: Kind,
+    /// `Kind::code`
+    kind: f32,
     /// Albedo, tint or radiance.
     color: Rgb,
     ior: f32,
-    is_wall: bool,
 }
 
 /// A sphere light's emitting cap, as light sampling draws it; `None` for
@@ -74,10 +81,21 @@ impl CapLight {
     };
 }
 
+/// A sphere as shadow rays test it.
+#[derive(Clone, Copy, Debug)]
+struct Occluder {
+    center: Vec3,
+    radius2: f32,
+}
+
 /// A world compiled for eight-lane path tracing.
 #[derive(Clone, Debug)]
 pub struct PathLanes {
     spheres: Vec<SphereInfo>,
+    /// Shadow rays test these always, and the walls only for paths not
+    /// inside every wall (see `occluders::Walls`).
+    others: Vec<Occluder>,
+    walls: Vec<Occluder>,
     lights: Vec<Option<CapLight>>,
     background: Rgb,
 }
@@ -90,7 +108,6 @@ impl PathLanes {
             return None;
         }
         let s = &world.spheres;
-        let walls = &world.walls.is_wall_sphere;
         let spheres = (0..s.radius.len())
             .map(|i| {
                 let object = s.object[i];
@@ -108,10 +125,9 @@ impl PathLanes {
                     radius2: radius * radius,
                     error: gamma(6) * (center.abs().max_element() + radius),
                     object,
-                    kind,
+                    kind: kind as u8 as f32,
                     color,
                     ior,
-                    is_wall: walls.get(i).copied().unwrap_or(false),
                 })
             })
             .collect::<Option<Vec<_>>>()?;
@@ -136,7 +152,16 @@ impl PathLanes {
                 _ => None,
             })
             .collect();
-        Some(PathLanes { spheres, lights, background: world.background })
+        let is_wall = |i: usize| world.walls.is_wall_sphere.get(i).copied().unwrap_or(false);
+        let occluder = |i: usize| Occluder { center: spheres[i].center, radius2: spheres[i].radius2 };
+        let (walls, others) = (0..spheres.len()).partition::<Vec<_>, _>(|&i| is_wall(i));
+        Some(PathLanes {
+            others: others.into_iter().map(occluder).collect(),
+            walls: walls.into_iter().map(occluder).collect(),
+            spheres,
+            lights,
+            background: world.background,
+        })
     }
 
     /// The radiance of every camera sample in `paths`, into `out`.
@@ -204,23 +229,32 @@ impl PathLanes {
         }
     }
 
-    /// One bounce of every active path: `path::radiance`'s loop body.
+    /// One bounce of every active path: `path::radiance`'s loop body. The
+    /// paths that end here hand their radiance out.
     #[inline(always)]
     fn bounce(&self, world: &World, st: &mut Lanes, max_depth: u32, out: &mut [Rgb], counters: &mut Counters) {
+        let done = self.bounce_live(world, st, max_depth, counters);
+        st.finish(done, out);
+    }
+
+    /// `bounce` but for handing out: the lanes whose paths ended.
+    #[inline(always)]
+    fn bounce_live(&self, world: &World, st: &mut Lanes, max_depth: u32, counters: &mut Counters) -> M8 {
         let active = st.active;
         counters.rays += active.count();
         let (origin, direction) = (st.origin, st.direction);
 
         // Nearest sphere, in index order: ties keep the first, as `SphereLanes::nearest`
         let mut t_hit = F8::splat(f32::INFINITY);
-        // The index in a float lane: one blend per sphere
+        // The index in a float lane, counted there too: one blend per sphere
         let mut index = F8::splat(0.0);
+        let mut k = F8::splat(0.0);
         let mut near = M8::NONE;
-        for (k, sphere) in self.spheres.iter().enumerate() {
-            let (t, is_near) = roots(origin, direction, sphere.center, sphere.radius2, t_hit);
-            let closer = t.lt(t_hit);
+        for sphere in &self.spheres {
+            let (t, closer, is_near) = roots(origin, direction, sphere.center, sphere.radius2, t_hit);
             t_hit = closer.select(t, t_hit);
-            index = closer.select(F8::splat(k as f32), index);
+            index = closer.select(k, index);
+            k = k + 1.0;
             near = closer.select_mask(is_near, near);
         }
         let found = active.and(t_hit.lt(F8::splat(f32::INFINITY)));
@@ -228,14 +262,14 @@ impl PathLanes {
         if missed.any() {
             let lit = st.radiance + st.throughput * V8::splat(self.background);
             st.radiance = missed.select_v(lit, st.radiance);
-            st.finish(missed, out);
         }
         let alive = found;
         if !alive.any() {
-            return;
+            return missed;
         }
         let sphere: [&SphereInfo; LANES] = std::array::from_fn(|i| &self.spheres[index.0[i] as usize]);
-        let kind = |k: Kind| M8::from_fn(|i| sphere[i].kind == k).and(alive);
+        let code = F8::from_fn(|i| sphere[i].kind);
+        let kind = |k: Kind| code.eq(k.code()).and(alive);
         let (lambert, mirror, glass, emissive) =
             (kind(Kind::Lambert), kind(Kind::Mirror), kind(Kind::Glass), kind(Kind::Emissive));
         let color = V8::from_fn(|i| sphere[i].color);
@@ -339,11 +373,10 @@ impl PathLanes {
             pdf = through.select(1.0 - fresnel, bounced.select(fresnel, pdf));
             scattered = scattered.or(glass);
         }
-        let ended = alive.and_not(scattered);
-        st.finish(ended, out);
         let go = scattered;
+        let done = missed.or(alive.and_not(scattered));
         if !go.any() {
-            return;
+            return done;
         }
         st.throughput = go.select_v(st.throughput * weight, st.throughput);
         st.after_delta = lambert.select_mask(M8::NONE, go.select_mask(M8::ALL, st.after_delta));
@@ -351,7 +384,7 @@ impl PathLanes {
         st.last_point = go.select_v(point, st.last_point);
 
         // Russian roulette after the first bounces
-        let roulette = M8::from_fn(|i| st.depth[i] + 1 >= ROULETTE_DEPTH).and(go);
+        let roulette = st.depth.ge(ROULETTE_DEPTH - 1).and(go);
         let mut killed = M8::NONE;
         if roulette.any() {
             let survive = st.throughput.max_element().min(F8::splat(0.95));
@@ -362,16 +395,11 @@ impl PathLanes {
             let kept = roulette.and_not(killed);
             st.throughput = kept.select_v(st.throughput / survive, st.throughput);
         }
-        st.finish(killed, out);
         let go = go.and_not(killed);
         st.origin = go.select_v(offset_ray_origin(point, error, normal, wi), st.origin);
         st.direction = go.select_v(wi, st.direction);
-        let mut deep = M8::NONE;
-        for lane in (0..LANES).filter(|&i| go.test(i)) {
-            st.depth[lane] += 1;
-            deep.set(lane, st.depth[lane] >= max_depth);
-        }
-        st.finish(deep, out);
+        st.depth = st.depth.count_in(go);
+        done.or(killed).or(go.and(st.depth.ge(max_depth)))
     }
 
     /// Lanes of `mask` whose shadow ray (origin, unit direction, t_max) is
@@ -379,15 +407,17 @@ impl PathLanes {
     #[inline(always)]
     fn blocked(&self, mask: M8, inside_walls: M8, origin: V8, direction: V8, t_max: F8) -> M8 {
         let mut blocked = M8::NONE;
-        for sphere in &self.spheres {
-            let tested = if sphere.is_wall { mask.and_not(inside_walls) } else { mask };
-            if !tested.any() {
-                continue;
-            }
-            let (t, _) = roots(origin, direction, sphere.center, sphere.radius2, t_max);
-            blocked = blocked.or(tested.and(t.lt(t_max)));
+        // Plain loops: a closure here would not inherit AVX2
+        for sphere in &self.others {
+            blocked = blocked.or(roots(origin, direction, sphere.center, sphere.radius2, t_max).1);
         }
-        blocked
+        let outside = mask.and_not(inside_walls);
+        if outside.any() {
+            for sphere in &self.walls {
+                blocked = blocked.or(outside.and(roots(origin, direction, sphere.center, sphere.radius2, t_max).1));
+            }
+        }
+        mask.and(blocked)
     }
 }
 
@@ -395,7 +425,7 @@ impl PathLanes {
 struct Lanes {
     active: M8,
     slot: [usize; LANES],
-    depth: [u32; LANES],
+    depth: Count8,
     inside_walls: M8,
     origin: V8,
     direction: V8,
@@ -413,7 +443,7 @@ impl Lanes {
         Lanes {
             active: M8::NONE,
             slot: [0; LANES],
-            depth: [0; LANES],
+            depth: Count8([0; LANES]),
             inside_walls: M8::NONE,
             origin: zero,
             direction: zero,
@@ -430,7 +460,7 @@ impl Lanes {
     fn start(&mut self, lane: usize, slot: usize, ray: &Ray, sampler: &Sampler, inside_walls: bool) {
         self.active.set(lane, true);
         self.slot[lane] = slot;
-        self.depth[lane] = 0;
+        self.depth.0[lane] = 0;
         self.inside_walls.set(lane, inside_walls);
         self.origin.set_lane(lane, ray.origin);
         self.direction.set_lane(lane, ray.direction);
@@ -448,6 +478,45 @@ impl Lanes {
         for lane in (0..LANES).filter(|&i| mask.test(i)) {
             out[self.slot[lane]] = self.radiance.lane(lane);
             self.active.set(lane, false);
+        }
+    }
+}
+
+/// Sphere-cap lights in eight lanes.
+struct CapLanes {
+    center: V8,
+    radius: F8,
+    error: F8,
+    frame: [V8; 3],
+    one_minus_cos: F8,
+    area: F8,
+    radiance: V8,
+}
+
+impl CapLanes {
+    #[inline(always)]
+    fn splat(cap: &CapLight) -> Self {
+        CapLanes {
+            center: V8::splat(cap.center),
+            radius: F8::splat(cap.radius),
+            error: F8::splat(cap.error),
+            frame: cap.frame.map(V8::splat),
+            one_minus_cos: F8::splat(cap.one_minus_cos),
+            area: F8::splat(cap.area),
+            radiance: V8::splat(cap.radiance),
+        }
+    }
+
+    #[inline(always)]
+    fn gather(caps: [&CapLight; LANES]) -> Self {
+        CapLanes {
+            center: V8::from_fn(|i| caps[i].center),
+            radius: F8::from_fn(|i| caps[i].radius),
+            error: F8::from_fn(|i| caps[i].error),
+            frame: std::array::from_fn(|k| V8::from_fn(|i| caps[i].frame[k])),
+            one_minus_cos: F8::from_fn(|i| caps[i].one_minus_cos),
+            area: F8::from_fn(|i| caps[i].area),
+            radiance: V8::from_fn(|i| caps[i].radiance),
         }
     }
 }
@@ -481,7 +550,8 @@ impl LightLanes {
         hit: &impl Fn(usize) -> SurfaceHit,
     ) -> LightLanes {
         let cap = |i: usize| lanes.lights[pick[i]].as_ref();
-        let cap_lanes = M8::from_fn(|i| cap(i).is_some()).and(mask);
+        let all_caps = lanes.lights.iter().all(Option::is_some);
+        let cap_lanes = if all_caps { mask } else { M8::from_fn(|i| cap(i).is_some()).and(mask) };
         let mut out = LightLanes {
             valid: M8::NONE,
             delta: M8::NONE,
@@ -492,20 +562,15 @@ impl LightLanes {
             t_max: F8::splat(0.0),
         };
         if cap_lanes.any() {
-            // Lanes without a cap compute on the first cap, unused
-            let first = lanes.lights.iter().flatten().next().unwrap_or(&CapLight::NONE);
-            let caps: [&CapLight; LANES] = std::array::from_fn(|i| cap(i).unwrap_or(first));
-            let center = V8::from_fn(|i| caps[i].center);
-            let radius = F8::from_fn(|i| caps[i].radius);
-            let light_error = F8::from_fn(|i| caps[i].error);
-            let frame = [
-                V8::from_fn(|i| caps[i].frame[0]),
-                V8::from_fn(|i| caps[i].frame[1]),
-                V8::from_fn(|i| caps[i].frame[2]),
-            ];
-            let one_minus_cos = F8::from_fn(|i| caps[i].one_minus_cos);
-            let area = F8::from_fn(|i| caps[i].area);
-            let radiance = V8::from_fn(|i| caps[i].radiance);
+            let caps = match lanes.lights.as_slice() {
+                [Some(only)] => CapLanes::splat(only),
+                _ => {
+                    // Lanes without a cap compute on the first cap, unused
+                    let first = lanes.lights.iter().flatten().next().unwrap_or(&CapLight::NONE);
+                    CapLanes::gather(std::array::from_fn(|i| cap(i).unwrap_or(first)))
+                }
+            };
+            let CapLanes { center, radius, error: light_error, frame, one_minus_cos, area, radiance } = caps;
 
             // Uniform over the cap (`sample_area`)
             let light_normal = to_world(frame, uniform_cone(u, one_minus_cos));
@@ -523,7 +588,8 @@ impl LightLanes {
             let valid = cap_lanes.and(pdf.gt(F8::splat(0.0))).and(faces);
             out = LightLanes { valid, delta: M8::NONE, wi, value: radiance / pdf, pdf, origin, t_max };
         }
-        for lane in (0..LANES).filter(|&i| mask.test(i) && cap(i).is_none()) {
+        let others = if all_caps { M8::NONE } else { mask.and_not(cap_lanes) };
+        for lane in (0..LANES).filter(|&i| others.test(i)) {
             let light = &world.lights[pick[lane]];
             let u = Vec2::new(u.0 .0[lane], u.1 .0[lane]);
             if let Some(sample) = light.sample(world, &hit(lane), u) {
@@ -540,11 +606,11 @@ impl LightLanes {
     }
 }
 
-/// Per lane, the nearest root of the sphere in (0, t_max) or infinity, and
-/// whether it is the near one: `SphereLanes::group`'s arithmetic with the
-/// rays in the lanes.
+/// Per lane, the nearest root t of the sphere, whether it lies in (0, t_max)
+/// (t means nothing where not) and whether it is the near one:
+/// `SphereLanes::group`'s arithmetic with the rays in the lanes.
 #[inline(always)]
-fn roots(origin: V8, direction: V8, center: Vec3, radius2: f32, t_max: F8) -> (F8, M8) {
+fn roots(origin: V8, direction: V8, center: Vec3, radius2: f32, t_max: F8) -> (F8, M8, M8) {
     let f = origin - V8::splat(center);
     let b = f.dot(direction);
     let l = f - direction * b;
@@ -555,11 +621,11 @@ fn roots(origin: V8, direction: V8, center: Vec3, radius2: f32, t_max: F8) -> (F
     let q = -b - discriminant.max_glam(zero).sqrt().copysign(b);
     let t0 = c / q;
     let (near, far) = (t0.min_glam(q), t0.max_glam(q));
-    let hits = discriminant.ge(zero);
-    let near_ok = hits.and(near.gt(zero)).and(near.lt(t_max));
-    let far_ok = hits.and(far.gt(zero)).and(far.lt(t_max));
-    let t = near_ok.select(near, far_ok.select(far, F8::splat(f32::INFINITY)));
-    (t, near_ok)
+    // The far root only where the near one is behind: beyond t_max, both are
+    let near_ahead = near.gt(zero);
+    let t = near_ahead.select(near, far);
+    let ok = discriminant.ge(zero).and(t.gt(zero)).and(t.lt(t_max));
+    (t, ok, near_ahead)
 }
 
 #[inline(always)]
@@ -610,14 +676,21 @@ fn sin_cos(x: F8) -> (F8, F8) {
     let quadrant = shifted - ROUND_BY_ADDING;
     let k: [u32; LANES] = shifted.0.map(f32::to_bits);
     let r = ((x - quadrant * PI_2_HI) - quadrant * PI_2_MID) - quadrant * PI_2_LO;
-    let r2 = r * r;
-    let sin = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));
-    let cos = 1.0 - 0.5 * r2 + r2 * r2 * (4.166_664_6e-2 + r2 * (-1.388_731_6e-3 + r2 * 2.443_315_7e-5));
+    let (sin, cos) = sin_cos_reduced(r);
     let swap = M8::from_fn(|i| k[i] & 1 != 0);
     let sin_negative = M8::from_fn(|i| k[i] & 2 != 0);
     let cos_negative = M8::from_fn(|i| (k[i] + 1) & 2 != 0);
     let (s, c) = (swap.select(cos, sin), swap.select(sin, cos));
     (sin_negative.select(-s, s), cos_negative.select(-c, c))
+}
+
+/// `sampling::sin_cos_reduced` in lanes.
+#[inline(always)]
+fn sin_cos_reduced(r: F8) -> (F8, F8) {
+    let r2 = r * r;
+    let sin = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));
+    let cos = 1.0 - 0.5 * r2 + r2 * r2 * (4.166_664_6e-2 + r2 * (-1.388_731_6e-3 + r2 * 2.443_315_7e-5));
+    (sin, cos)
 }
 
 /// `sampling::cosine_hemisphere` (through the concentric disc) in lanes.
@@ -628,10 +701,9 @@ fn cosine_hemisphere(u: (F8, F8)) -> V8 {
     let centre = ox.eq(zero).and(oy.eq(zero));
     let wide = ox.abs().gt(oy.abs());
     let r = wide.select(ox, oy);
-    let theta = wide.select(FRAC_PI_4 * (oy / ox), FRAC_PI_2 - FRAC_PI_4 * (ox / oy));
-    let (sin, cos) = sin_cos(theta);
-    let dx = centre.select(zero, r * cos);
-    let dy = centre.select(zero, r * sin);
+    let (sin, cos) = sin_cos_reduced(FRAC_PI_4 * (wide.select(oy, ox) / r));
+    let dx = centre.select(zero, r * wide.select(cos, sin));
+    let dy = centre.select(zero, r * wide.select(sin, cos));
     let z = (1.0 - (dx * dx + dy * dy)).max(zero).sqrt();
     V8 { x: dx, y: dy, z }
 }

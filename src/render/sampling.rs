@@ -1,6 +1,6 @@
 //! Warps from the unit square to directions and points, with their pdfs.
 
-use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_2, FRAC_PI_4, PI};
+use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
@@ -25,15 +25,22 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
     let quadrant = shifted - ROUND_BY_ADDING;
     let k = shifted.to_bits();
     let r = ((x - quadrant * PI_2_HI) - quadrant * PI_2_MID) - quadrant * PI_2_LO;
-    let r2 = r * r;
-    let sin = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));
-    let cos = 1.0 - 0.5 * r2 + r2 * r2 * (4.166_664_6e-2 + r2 * (-1.388_731_6e-3 + r2 * 2.443_315_7e-5));
+    let (sin, cos) = sin_cos_reduced(r);
     match k & 3 {
         0 => (sin, cos),
         1 => (cos, -sin),
         2 => (-sin, -cos),
         _ => (-cos, sin),
     }
+}
+
+/// `sin_cos` for |r| ≤ π/4: cephes' minimax polynomials alone.
+#[inline(always)]
+pub(crate) fn sin_cos_reduced(r: f32) -> (f32, f32) {
+    let r2 = r * r;
+    let sin = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));
+    let cos = 1.0 - 0.5 * r2 + r2 * r2 * (4.166_664_6e-2 + r2 * (-1.388_731_6e-3 + r2 * 2.443_315_7e-5));
+    (sin, cos)
 }
 
 /// Shirley–Chiu concentric map: low distortion, so stratification survives.
@@ -43,10 +50,16 @@ pub fn concentric_disk(u: Vec2) -> Vec2 {
     if o == Vec2::ZERO {
         return Vec2::ZERO;
     }
-    let (r, theta) =
-        if o.x.abs() > o.y.abs() { (o.x, FRAC_PI_4 * (o.y / o.x)) } else { (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y)) };
-    let (sin, cos) = sin_cos(theta);
-    r * Vec2::new(cos, sin)
+    // The angle is φ = π/4 · ratio in the wide wedges and π/2 − φ in the
+    // tall ones, whose sine and cosine are φ's swapped: no range reduction
+    let wide = o.x.abs() > o.y.abs();
+    let (r, ratio) = if wide { (o.x, o.y / o.x) } else { (o.y, o.x / o.y) };
+    let (sin, cos) = sin_cos_reduced(FRAC_PI_4 * ratio);
+    if wide {
+        r * Vec2::new(cos, sin)
+    } else {
+        r * Vec2::new(sin, cos)
+    }
 }
 
 /// Cosine-weighted direction about +z; pdf = cos θ / π.
@@ -125,6 +138,8 @@ pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
 
 #[cfg(test)]
 mod tests {
+    use std::f32::consts::FRAC_PI_2;
+
     use super::*;
     use crate::render::rng::Sampler;
 
@@ -156,6 +171,29 @@ mod tests {
         }
         assert!(worst < 2e-7, "worst error {worst}");
         assert_eq!(sin_cos(0.0), (0.0, 1.0));
+    }
+
+    /// Against Shirley–Chiu's map as written (r, θ), in f64: the swapped
+    /// sine and cosine of the tall wedges put points where θ says.
+    #[test]
+    fn concentric_disk_matches_the_map_in_f64() {
+        let mut s = Sampler::new(3, 1, 4);
+        let corners = [[0.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.75, 0.5], [0.5, 0.25], [0.5, 0.5]];
+        for u in (0..50_000).map(|_| s.next_2d()).chain(corners.map(Vec2::from_array)) {
+            let (x, y) = (2.0 * u.x as f64 - 1.0, 2.0 * u.y as f64 - 1.0);
+            let expected = if x == 0.0 && y == 0.0 {
+                (0.0, 0.0)
+            } else if x.abs() > y.abs() {
+                let theta = std::f64::consts::FRAC_PI_4 * (y / x);
+                (x * theta.cos(), x * theta.sin())
+            } else {
+                let theta = std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (x / y);
+                (y * theta.cos(), y * theta.sin())
+            };
+            let d = concentric_disk(u);
+            let error = (d.x as f64 - expected.0).abs().max((d.y as f64 - expected.1).abs());
+            assert!(error < 4e-7, "{u}: {d} against {expected:?}");
+        }
     }
 
     #[test]
