@@ -66,9 +66,7 @@ impl PhotonRenderer<'_> {
             radiance += throughput * world.emitted(&hit, wo);
             let bsdf = Bsdf::new(world.material_of(&hit));
             if bsdf.is_specular() {
-                let Some(s) =
-                    bsdf.sample(wo, hit.surface.normal, sampler.next_f32(), sampler.next_2d(), Transport::Radiance)
-                else {
+                let Some(s) = bsdf.sample(wo, hit.surface.normal, sampler, Transport::Radiance) else {
                     break;
                 };
                 throughput *= s.weight;
@@ -102,7 +100,7 @@ impl PhotonRenderer<'_> {
             let rays = self.settings.final_gather_rays.max(1);
             let mut sum = Rgb::ZERO;
             for _ in 0..rays {
-                let Some(s) = bsdf.sample(wo, n, sampler.next_f32(), sampler.next_2d(), Transport::Radiance) else {
+                let Some(s) = bsdf.sample(wo, n, sampler, Transport::Radiance) else {
                     continue;
                 };
                 sum += s.weight * self.gathered(hit.surface.spawn_ray(s.wi), sampler, counters, scratch);
@@ -112,7 +110,7 @@ impl PhotonRenderer<'_> {
             // Photons come only from lights: the background reaches the
             // surface through one BSDF-sampled ray
             if world.background != Rgb::ZERO {
-                if let Some(s) = bsdf.sample(wo, n, sampler.next_f32(), sampler.next_2d(), Transport::Radiance) {
+                if let Some(s) = bsdf.sample(wo, n, sampler, Transport::Radiance) {
                     counters.rays += 1;
                     if world.intersect(&hit.surface.spawn_ray(s.wi), f32::INFINITY).is_none() {
                         radiance += s.weight * world.background;
@@ -147,9 +145,7 @@ impl PhotonRenderer<'_> {
                 let facing = if wo.dot(n) < 0.0 { -n } else { n };
                 return throughput * self.radiance_from_maps(&hit, wo, facing, &bsdf, true, sampler, counters, scratch);
             }
-            let Some(s) =
-                bsdf.sample(wo, hit.surface.normal, sampler.next_f32(), sampler.next_2d(), Transport::Radiance)
-            else {
+            let Some(s) = bsdf.sample(wo, hit.surface.normal, sampler, Transport::Radiance) else {
                 return Rgb::ZERO;
             };
             throughput *= s.weight;

@@ -106,7 +106,7 @@ pub fn camera_pass(
         let bsdf = Bsdf::new(world.material_of(&hit));
         let n = hit.surface.normal;
         if bsdf.is_specular() {
-            let Some(s) = bsdf.sample(wo, n, sampler.next_f32(), sampler.next_2d(), Transport::Radiance) else {
+            let Some(s) = bsdf.sample(wo, n, sampler, Transport::Radiance) else {
                 break;
             };
             throughput *= s.weight;
@@ -116,7 +116,7 @@ pub fn camera_pass(
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
         radiance += throughput * direct_light(occluders, &hit, wo, facing, &bsdf, sampler, counters);
         if world.background != Rgb::ZERO {
-            if let Some(s) = bsdf.sample(wo, n, sampler.next_f32(), sampler.next_2d(), Transport::Radiance) {
+            if let Some(s) = bsdf.sample(wo, n, sampler, Transport::Radiance) {
                 counters.rays += 1;
                 if world.intersect(&hit.surface.spawn_ray(s.wi), f32::INFINITY).is_none() {
                     radiance += throughput * s.weight * world.background;

@@ -94,13 +94,7 @@ fn trace_one(
                 return;
             }
         }
-        let Some(scattered) = bsdf.sample(
-            -ray.direction,
-            hit.surface.normal,
-            sampler.next_f32(),
-            sampler.next_2d(),
-            Transport::Importance,
-        ) else {
+        let Some(scattered) = bsdf.sample(-ray.direction, hit.surface.normal, sampler, Transport::Importance) else {
             return;
         };
         if !scattered.delta {

@@ -4,8 +4,9 @@
 
 use std::f32::consts::{FRAC_1_PI, PI};
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
+use super::rng::Sampler;
 use super::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power_cosine, power_cosine_pdf};
 use crate::geometry::Frame;
 use crate::scene::{MaterialModel, Rgb};
@@ -171,7 +172,8 @@ impl Bsdf {
     /// opaque models flip it to `wo`'s side, glass uses it to tell entering
     /// from leaving.
     #[inline]
-    pub fn sample(&self, wo: Vec3, n: Vec3, u_lobe: f32, u: Vec2, transport: Transport) -> Option<BsdfSample> {
+    /// Each model draws from `sampler` only the numbers it uses.
+    pub fn sample(&self, wo: Vec3, n: Vec3, sampler: &mut Sampler, transport: Transport) -> Option<BsdfSample> {
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
         let scattered = |wi: Vec3| -> Option<BsdfSample> {
             let pdf = self.pdf(wo, wi, facing);
@@ -183,11 +185,12 @@ impl Bsdf {
         };
         match *self {
             Bsdf::Lambert { albedo } => {
-                let wi = Frame::from_z(facing).to_world(cosine_hemisphere(u));
+                let wi = Frame::from_z(facing).to_world(cosine_hemisphere(sampler.next_2d()));
                 let cos = wi.dot(facing);
                 (cos > 0.0).then(|| BsdfSample { wi, weight: albedo, pdf: cosine_hemisphere_pdf(cos), delta: false })
             }
             Bsdf::Phong { kd, ks, exponent } => {
+                let (u_lobe, u) = (sampler.next_f32(), sampler.next_2d());
                 let wi = if u_lobe < Self::diffuse_probability(kd, ks) {
                     Frame::from_z(facing).to_world(cosine_hemisphere(u))
                 } else {
@@ -196,6 +199,7 @@ impl Bsdf {
                 scattered(wi)
             }
             Bsdf::BlinnPhong { kd, ks, exponent } => {
+                let (u_lobe, u) = (sampler.next_f32(), sampler.next_2d());
                 let wi = if u_lobe < Self::diffuse_probability(kd, ks) {
                     Frame::from_z(facing).to_world(cosine_hemisphere(u))
                 } else {
@@ -210,7 +214,8 @@ impl Bsdf {
                 let (eta_i, eta_t) = if entering { (1.0, ior) } else { (ior, 1.0) };
                 let (fresnel, refracted, eta) = refract(wo, facing, eta_i, eta_t);
                 match refracted {
-                    Some(wt) if u_lobe >= fresnel => {
+                    // A lobe to choose only where refraction is possible
+                    Some(wt) if sampler.next_f32() >= fresnel => {
                         let scale = if transport == Transport::Radiance { eta * eta } else { 1.0 };
                         Some(BsdfSample { wi: wt, weight: tint * scale, pdf: 1.0 - fresnel, delta: true })
                     }
@@ -225,13 +230,12 @@ impl Bsdf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::rng::Sampler;
 
     fn directional_albedo(bsdf: &Bsdf, wo: Vec3, n: usize) -> Rgb {
         let mut s = Sampler::new(0, 0, 5);
         let mut sum = Rgb::ZERO;
         for _ in 0..n {
-            if let Some(b) = bsdf.sample(wo, Vec3::Z, s.next_f32(), s.next_2d(), Transport::Radiance) {
+            if let Some(b) = bsdf.sample(wo, Vec3::Z, &mut s, Transport::Radiance) {
                 sum += b.weight;
             }
         }
@@ -248,7 +252,7 @@ mod tests {
         let mut s = Sampler::new(1, 1, 1);
         for bsdf in bsdfs {
             for _ in 0..1000 {
-                if let Some(b) = bsdf.sample(wo, Vec3::Z, s.next_f32(), s.next_2d(), Transport::Radiance) {
+                if let Some(b) = bsdf.sample(wo, Vec3::Z, &mut s, Transport::Radiance) {
                     let expected = bsdf.eval(wo, b.wi, Vec3::Z) * b.wi.z / bsdf.pdf(wo, b.wi, Vec3::Z);
                     assert!((expected - b.weight).abs().max_element() < 1e-3 * (1.0 + expected.max_element()));
                 }

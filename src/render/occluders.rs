@@ -141,6 +141,18 @@ impl Walls {
     pub(crate) fn hold(&self, origin: Vec3) -> bool {
         !self.regions.is_empty() && self.regions.iter().all(|region| region.holds_strictly_f32(origin))
     }
+
+    /// Whether every path starting in the box [min, max] is inside every
+    /// wall: walls bound convex regions, so the box's corners decide.
+    pub(crate) fn hold_box(&self, min: Vec3, max: Vec3) -> bool {
+        let corners = (0..8).map(|i| {
+            let pick = |bit: u32, low: f32, high: f32| if i & bit == 0 { low } else { high };
+            DVec3::new(pick(1, min.x, max.x) as f64, pick(2, min.y, max.y) as f64, pick(4, min.z, max.z) as f64)
+        });
+        !self.regions.is_empty()
+            && min.cmple(max).all()
+            && corners.into_iter().all(|p| self.regions.iter().all(|region| region.holds_strictly(p)))
+    }
 }
 
 /// Whether every sample `light` can give lies in `region`, the inside of
@@ -302,6 +314,25 @@ mod tests {
             }
         }
         assert!(near_in > 1000 && near_out > 1000, "{near_in} in, {near_out} out near the surface");
+    }
+
+    /// A box inside every wall holds every point in it; one that crosses a
+    /// wall, or an empty one, holds nothing.
+    #[test]
+    fn a_box_of_origins_is_held_by_its_corners() {
+        let w = world(&preset("smallpt"));
+        let mut s = Sampler::new(4, 5, 6);
+        let (low, high) = (Vec3::new(40.0, 40.0, 150.0), Vec3::new(60.0, 60.0, 169.9));
+        assert!(w.walls.hold_box(low, high));
+        for _ in 0..1000 {
+            let p = low + (high - low) * Vec3::new(s.next_f32(), s.next_f32(), s.next_f32());
+            assert!(w.walls.hold(p), "{p}");
+        }
+        // Past the front wall (z = 170), past the ceiling, and inside out
+        assert!(!w.walls.hold_box(low, Vec3::new(60.0, 60.0, 170.5)));
+        assert!(!w.walls.hold_box(low, Vec3::new(60.0, 82.0, 160.0)));
+        assert!(!w.walls.hold_box(high, low));
+        assert!(!Walls::default().hold_box(low, low), "no walls, nothing held");
     }
 
     /// Whether `p` lies within rounding of a wall's surface.

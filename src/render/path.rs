@@ -53,7 +53,10 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
 
         // Next-event estimation: one light, chosen uniformly
         if !bsdf.is_specular() && light_count > 0 {
-            let pick = ((sampler.next_f32() * light_count as f32) as usize).min(light_count - 1);
+            let pick = match light_count {
+                1 => 0,
+                _ => ((sampler.next_f32() * light_count as f32) as usize).min(light_count - 1),
+            };
             let light = &world.lights[pick];
             if let Some(sample) = light.sample(world, &hit.surface, sampler.next_2d()) {
                 let f = bsdf.eval(wo, sample.wi, facing);
@@ -71,7 +74,7 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
             }
         }
 
-        let Some(scattered) = bsdf.sample(wo, n, sampler.next_f32(), sampler.next_2d(), Transport::Radiance) else {
+        let Some(scattered) = bsdf.sample(wo, n, sampler, Transport::Radiance) else {
             break;
         };
         throughput *= scattered.weight;

@@ -209,6 +209,11 @@ impl PathLanes {
     ) {
         let mut state = Lanes::new();
         let mut next = 0;
+        // Camera rays of a tile start close together: mostly all inside the walls
+        let (low, high) = paths.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(low, high), (ray, _)| {
+            (low.min(ray.origin), high.max(ray.origin))
+        });
+        let all_inside = world.walls.hold_box(low, high);
         loop {
             // Idle lanes take the next sample
             for lane in 0..LANES {
@@ -217,7 +222,7 @@ impl PathLanes {
                     if max_depth == 0 {
                         out[next] = Rgb::ZERO;
                     } else {
-                        state.start(lane, next, ray, sampler, world.walls.hold(ray.origin));
+                        state.start(lane, next, ray, sampler, all_inside || world.walls.hold(ray.origin));
                     }
                     next += 1;
                 }
@@ -249,13 +254,11 @@ impl PathLanes {
         // The index in a float lane, counted there too: one blend per sphere
         let mut index = F8::splat(0.0);
         let mut k = F8::splat(0.0);
-        let mut near = M8::NONE;
         for sphere in &self.spheres {
-            let (t, closer, is_near) = roots(origin, direction, sphere.center, sphere.radius2, t_hit);
+            let (t, closer) = roots(origin, direction, sphere.center, sphere.radius2, t_hit);
             t_hit = closer.select(t, t_hit);
             index = closer.select(k, index);
             k = k + 1.0;
-            near = closer.select_mask(is_near, near);
         }
         let found = active.and(t_hit.lt(F8::splat(f32::INFINITY)));
         let missed = active.and_not(found);
@@ -279,6 +282,8 @@ impl PathLanes {
         let radius = F8::from_fn(|i| sphere[i].radius);
         let error = F8::from_fn(|i| sphere[i].error);
         let f = origin - center;
+        // Which root `roots` took (solved again: cheaper than tracking it through the search)
+        let near = solve(f, direction, radius * radius).0.gt(F8::splat(0.0));
         let closest = f - direction * f.dot(direction);
         let half_chord = (radius * radius - closest.length_squared()).max(F8::splat(0.0)).sqrt();
         let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
@@ -311,10 +316,10 @@ impl PathLanes {
 
         // Next-event estimation toward one light, chosen uniformly
         if light_count > 0 && lambert.any() {
-            let u_pick = st.rng.next_f32(lambert);
             let pick: [usize; LANES] = if light_count == 1 {
                 [0; LANES]
             } else {
+                let u_pick = st.rng.next_f32(lambert);
                 std::array::from_fn(|i| ((u_pick.0[i] * light_count as f32) as usize).min(light_count - 1))
             };
             let u = (st.rng.next_f32(lambert), st.rng.next_f32(lambert));
@@ -338,15 +343,13 @@ impl PathLanes {
             }
         }
 
-        // Scattering: every live lane draws its three numbers
-        let u_lobe = st.rng.next_f32(alive);
-        let u = (st.rng.next_f32(alive), st.rng.next_f32(alive));
+        // Scattering: each material draws what it uses (`Bsdf::sample`)
         let mut wi = reflect(wo, facing);
         let mut weight = color;
         let mut pdf = F8::splat(1.0);
         let mut scattered = mirror;
         if lambert.any() {
-            let local = cosine_hemisphere(u);
+            let local = cosine_hemisphere((st.rng.next_f32(lambert), st.rng.next_f32(lambert)));
             let w = to_world(from_z(facing), local);
             let cos = w.dot(facing);
             let ok = lambert.and(cos.gt(zero));
@@ -366,6 +369,7 @@ impl PathLanes {
             let cos_t = (1.0 - sin2_t).sqrt();
             let fresnel = total.select(F8::splat(1.0), fresnel_dielectric(cos_i, cos_t, eta_i, eta_t));
             let refracted = (wo * -eta + facing * (eta * cos_i - cos_t)).normalize();
+            let u_lobe = st.rng.next_f32(glass.and_not(total));
             let through = glass.and_not(total).and(u_lobe.ge(fresnel));
             let bounced = glass.and_not(through);
             wi = through.select_v(refracted, wi);
@@ -606,26 +610,29 @@ impl LightLanes {
     }
 }
 
-/// Per lane, the nearest root t of the sphere, whether it lies in (0, t_max)
-/// (t means nothing where not) and whether it is the near one:
-/// `SphereLanes::group`'s arithmetic with the rays in the lanes.
+/// The roots of a sphere along the rays, (near, far, discriminant), from
+/// f = origin − center: `SphereLanes::group`'s arithmetic with the rays in
+/// the lanes.
 #[inline(always)]
-fn roots(origin: V8, direction: V8, center: Vec3, radius2: f32, t_max: F8) -> (F8, M8, M8) {
-    let f = origin - V8::splat(center);
+fn solve(f: V8, direction: V8, radius2: F8) -> (F8, F8, F8) {
     let b = f.dot(direction);
     let l = f - direction * b;
-    let r2 = F8::splat(radius2);
-    let discriminant = r2 - l.length_squared();
-    let c = f.length_squared() - r2;
-    let zero = F8::splat(0.0);
-    let q = -b - discriminant.max_glam(zero).sqrt().copysign(b);
+    let discriminant = radius2 - l.length_squared();
+    let c = f.length_squared() - radius2;
+    let q = -b - discriminant.max_glam(F8::splat(0.0)).sqrt().copysign(b);
     let t0 = c / q;
-    let (near, far) = (t0.min_glam(q), t0.max_glam(q));
+    (t0.min_glam(q), t0.max_glam(q), discriminant)
+}
+
+/// Per lane, the nearest root t of the sphere and whether it lies in
+/// (0, t_max) (t means nothing where not).
+#[inline(always)]
+fn roots(origin: V8, direction: V8, center: Vec3, radius2: f32, t_max: F8) -> (F8, M8) {
+    let (near, far, discriminant) = solve(origin - V8::splat(center), direction, F8::splat(radius2));
     // The far root only where the near one is behind: beyond t_max, both are
-    let near_ahead = near.gt(zero);
-    let t = near_ahead.select(near, far);
-    let ok = discriminant.ge(zero).and(t.gt(zero)).and(t.lt(t_max));
-    (t, ok, near_ahead)
+    let zero = F8::splat(0.0);
+    let t = near.gt(zero).select(near, far);
+    (t, discriminant.ge(zero).and(t.gt(zero)).and(t.lt(t_max)))
 }
 
 #[inline(always)]
