@@ -15,6 +15,8 @@ pub struct CameraModel {
     /// Half extents of the image plane at distance 1.
     half_width: f32,
     half_height: f32,
+    /// A pixel's extent on that plane.
+    pixel_size: Vec2,
     near_clip: f32,
     aperture_radius: f32,
     focus_distance: f32,
@@ -34,13 +36,15 @@ impl CameraModel {
         } else {
             (camera.look_at - camera.position).dot(forward)
         };
+        let half_width = half_height * width as f32 / height as f32;
         Self {
             position: camera.position,
             right,
             up,
             forward,
-            half_width: half_height * width as f32 / height as f32,
+            half_width,
             half_height,
+            pixel_size: Vec2::new(2.0 * half_width / width as f32, 2.0 * half_height / height as f32),
             near_clip: camera.near_clip,
             aperture_radius: camera.aperture_radius,
             focus_distance,
@@ -53,20 +57,21 @@ impl CameraModel {
     /// lens sample `lens` in [0,1)².
     #[inline]
     pub fn generate_ray(&self, film: Vec2, lens: Vec2) -> Ray {
-        let sx = (2.0 * film.x / self.width - 1.0) * self.half_width;
-        let sy = (1.0 - 2.0 * film.y / self.height) * self.half_height;
+        // Pixels to the image plane by multiplications: a division here was
+        // a tenth of path tracing's time
+        let sx = film.x * self.pixel_size.x - self.half_width;
+        let sy = self.half_height - film.y * self.pixel_size.y;
         // Unit depth along the view axis, so scaling by a depth lands on that plane
         let through = self.forward + self.right * sx + self.up * sy;
-        let (origin, direction) = if self.aperture_radius > 0.0 {
+        if self.aperture_radius > 0.0 {
             let l = concentric_disk(lens) * self.aperture_radius;
             let on_lens = self.position + self.right * l.x + self.up * l.y;
             let in_focus = self.position + through * self.focus_distance;
-            (on_lens, (in_focus - on_lens).normalize())
+            let direction = (in_focus - on_lens).normalize();
+            Ray::new(on_lens + direction * (self.near_clip / direction.dot(self.forward)), direction)
         } else {
-            (self.position, through.normalize())
-        };
-        let origin = origin + direction * (self.near_clip / direction.dot(self.forward));
-        Ray::new(origin, direction)
+            Ray::new(self.position + through * self.near_clip, through.normalize())
+        }
     }
 
     /// Whether rays start across a lens (and so need a lens sample).

@@ -706,9 +706,14 @@ fn cosine_hemisphere(u: (F8, F8)) -> V8 {
     let (ox, oy) = (2.0 * u.0 - 1.0, 2.0 * u.1 - 1.0);
     let zero = F8::splat(0.0);
     let centre = ox.eq(zero).and(oy.eq(zero));
-    let wide = ox.abs().gt(oy.abs());
+    let (ax, ay) = (ox.abs(), oy.abs());
+    let wide = ax.gt(ay);
     let r = wide.select(ox, oy);
-    let (sin, cos) = sin_cos_reduced(FRAC_PI_4 * (wide.select(oy, ox) / r));
+    // oy / ox where wide, ox / oy elsewhere, as the smaller magnitude over
+    // the larger with the quotient's sign (bit for bit the same): a division
+    // of selected lanes was split into lane-by-lane branches
+    let ratio = (ax.min_glam(ay) / ax.max_glam(ay)).copysign(ox * oy);
+    let (sin, cos) = sin_cos_reduced(FRAC_PI_4 * ratio);
     let dx = centre.select(zero, r * wide.select(cos, sin));
     let dy = centre.select(zero, r * wide.select(sin, cos));
     let z = (1.0 - (dx * dx + dy * dy)).max(zero).sqrt();
