@@ -57,8 +57,7 @@ impl CameraModel {
     /// lens sample `lens` in [0,1)².
     #[inline]
     pub fn generate_ray(&self, film: Vec2, lens: Vec2) -> Ray {
-        // Pixels to the image plane by multiplications: a division here was
-        // a tenth of path tracing's time
+        // Pixels to the image plane: multiplications by a pixel's extent
         let sx = film.x * self.pixel_size.x - self.half_width;
         let sy = self.half_height - film.y * self.pixel_size.y;
         // Unit depth along the view axis, so scaling by a depth lands on that plane

@@ -154,13 +154,13 @@ impl Walls {
     /// Whether every path starting in the box [min, max] is inside every
     /// wall: walls bound convex regions, so the box's corners decide.
     pub(crate) fn hold_box(&self, min: Vec3, max: Vec3) -> bool {
-        let corners = (0..8).map(|i| {
+        let mut corners = (0..8).map(|i| {
             let pick = |bit: u32, low: f32, high: f32| if i & bit == 0 { low } else { high };
             DVec3::new(pick(1, min.x, max.x) as f64, pick(2, min.y, max.y) as f64, pick(4, min.z, max.z) as f64)
         });
         !self.regions.is_empty()
             && min.cmple(max).all()
-            && corners.into_iter().all(|p| self.regions.iter().all(|region| region.holds_strictly(p)))
+            && corners.all(|p| self.regions.iter().all(|region| region.holds_strictly(p)))
     }
 }
 
@@ -312,7 +312,7 @@ mod tests {
         for region in &w.walls.regions {
             let Region::Ball { center_f32, start_radius, .. } = *region else { continue };
             for _ in 0..20_000 {
-                // Distances from where paths may start from 1e-3 ulps to 1e4 units, either side
+                // 1e-5 to 1e4 units from where paths may start, either side
                 let offset = (10.0f64).powf(-5.0 + 9.0 * s.next_f32() as f64) * (2.0 * s.next_f32() as f64 - 1.0);
                 let p = (center_f32.as_dvec3() + uniform_sphere(s.next_2d()).as_dvec3() * (start_radius + offset))
                     .as_vec3();

@@ -242,7 +242,7 @@ impl PathLanes {
         st.finish(done, out);
     }
 
-    /// `bounce` but for handing out: the lanes whose paths ended.
+    /// `bounce` short of handing out: returns the lanes whose paths ended.
     #[inline(always)]
     fn bounce_live(&self, world: &World, st: &mut Lanes, max_depth: u32, counters: &mut Counters) -> M8 {
         let active = st.active;
@@ -283,9 +283,10 @@ impl PathLanes {
         let error = F8::from_fn(|i| sphere[i].error);
         let f = origin - center;
         // Which root `roots` took (solved again: cheaper than tracking it through the search)
-        let near = solve(f, direction, radius * radius).0.gt(F8::splat(0.0));
+        let (near_root, _, discriminant) = solve(f, direction, radius * radius);
+        let near = near_root.gt(F8::splat(0.0));
         let closest = f - direction * f.dot(direction);
-        let half_chord = (radius * radius - closest.length_squared()).max(F8::splat(0.0)).sqrt();
+        let half_chord = discriminant.max(F8::splat(0.0)).sqrt();
         let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
         let length = from_center.length();
         let normal = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
