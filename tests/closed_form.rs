@@ -216,10 +216,8 @@ fn floor_under_a_light_poking_through_the_ceiling() {
     };
 
     // The world samples exactly that cap: 1 − cos θ of the rim seen from the light's centre
-    let mut world = World::new(&scene);
     let camera = gi_studio::render::camera::CameraModel::new(&scene.camera, 32, 24);
-    let points = world.visible_points(&camera, 32, 24);
-    world.cover(&points, &camera);
+    let (world, _) = World::for_view(&scene, &camera, 32, 24);
     let cap = world.emitting_cap(1);
     let expected_cap = 1.0 - (y_light - h) / radius;
     assert!(((cap.one_minus_cos as f64) - expected_cap).abs() < 1e-3 * expected_cap, "{cap:?} vs {expected_cap}");

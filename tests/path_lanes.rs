@@ -21,10 +21,8 @@ fn preset(name: &str) -> Scene {
 }
 
 fn world(scene: &Scene, width: u32, height: u32) -> (World, CameraModel) {
-    let mut world = World::new(scene);
     let camera = CameraModel::new(&scene.camera, width, height);
-    let points = world.visible_points(&camera, width, height);
-    world.cover(&points, &camera);
+    let (world, _) = World::for_view(scene, &camera, width, height);
     (world, camera)
 }
 

@@ -152,11 +152,8 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
     let mut s = settings(Algorithm::Photon, 32, 24, 2);
     s.photon.global_photons = 20_000;
     s.photon.caustic_photons = 20_000;
-    let mut world = World::new(&scene);
     let camera = CameraModel::new(&scene.camera, s.width, s.height);
-    let points = world.visible_points(&camera, s.width, s.height);
-    world.cover(&points, &camera);
-    let visible = World::visible_radius(&points).unwrap();
+    let (world, visible) = World::for_view(&scene, &camera, s.width, s.height);
     let maps = PhotonMaps::build(&world, &s.photon, s.seed, s.max_depth, visible);
     let dir = std::env::temp_dir().join(format!("gi-pmap-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

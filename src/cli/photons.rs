@@ -31,11 +31,8 @@ pub fn run(args: &PhotonsArgs) -> Result<()> {
     let settings = args.flags.settings(&scene)?;
     let bar = ProgressBar::new_spinner().with_message("tracing photons");
     bar.enable_steady_tick(Duration::from_millis(120));
-    let mut world = World::new(&scene);
     let camera = CameraModel::new(&scene.camera, settings.width, settings.height);
-    let visible = world.visible_points(&camera, settings.width, settings.height);
-    world.cover(&visible, &camera);
-    let visible_radius = World::visible_radius(&visible).unwrap_or(world.bounds_radius.max(1.0));
+    let (world, visible_radius) = World::for_view(&scene, &camera, settings.width, settings.height);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build()?;
     let maps =
         pool.install(|| PhotonMaps::build(&world, &settings.photon, settings.seed, settings.max_depth, visible_radius));

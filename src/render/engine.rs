@@ -278,11 +278,8 @@ fn run_job(context: &JobContext, job: &RenderJob) {
         context.send(RenderEvent::Failed { generation, message: "image size must be at least 1×1".into() });
         return;
     }
-    let mut world = World::new(&job.scene);
     let camera = CameraModel::new(&job.scene.camera, settings.width, settings.height);
-    let visible = world.visible_points(&camera, settings.width, settings.height);
-    world.cover(&visible, &camera);
-    let visible_radius = World::visible_radius(&visible).unwrap_or(world.bounds_radius.max(1.0));
+    let (world, visible_radius) = World::for_view(&job.scene, &camera, settings.width, settings.height);
     let start = Instant::now();
     let method = match settings.algorithm {
         Algorithm::Whitted => Method::Sample,

@@ -122,11 +122,6 @@ impl F8 {
     pub fn copysign(self, sign: F8) -> Self {
         self.zip(sign, f32::copysign)
     }
-
-    #[inline(always)]
-    pub fn is_nan(self) -> M8 {
-        self.compare(self, |a, b| a != b)
-    }
 }
 
 macro_rules! lane_op {
@@ -447,7 +442,6 @@ mod tests {
         assert!(s.0[1].is_sign_negative());
         assert_eq!(a.min_glam(b).0[3], 0.5, "glam's min takes the second operand on NaN");
         assert_eq!(a.max(b).0[3], 0.5);
-        assert_eq!(a.is_nan().0, [0, 0, 0, -1, 0, 0, 0, 0]);
         let v = V8::from_fn(|i| Vec3::new(i as f32, 1.0, -2.0));
         assert_eq!(v.lane(3), Vec3::new(3.0, 1.0, -2.0));
         assert_eq!(v.dot(v).0[3], Vec3::new(3.0, 1.0, -2.0).length_squared());

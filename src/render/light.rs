@@ -239,10 +239,7 @@ mod tests {
     #[test]
     fn smallpt_light_samples_land_under_the_ceiling() {
         let scene = crate::scene::presets::preset("smallpt").and_then(Result::ok).expect("smallpt preset");
-        let mut world = World::new(&scene);
-        let camera = CameraModel::new(&scene.camera, 64, 48);
-        let points = world.visible_points(&camera, 64, 48);
-        world.cover(&points, &camera);
+        let (world, _) = World::for_view(&scene, &CameraModel::new(&scene.camera, 64, 48), 64, 48);
         let ceiling = world.spheres.center(5).as_dvec3();
         let mut s = Sampler::new(0, 0, 600);
         let (mut taken, mut reached) = (0, 0);

@@ -250,11 +250,7 @@ mod tests {
     }
 
     fn world(scene: &Scene) -> World {
-        let mut world = World::new(scene);
-        let camera = CameraModel::new(&scene.camera, 64, 48);
-        let points = world.visible_points(&camera, 64, 48);
-        world.cover(&points, &camera);
-        world
+        World::for_view(scene, &CameraModel::new(&scene.camera, 64, 48), 64, 48).0
     }
 
     fn point_light(position: Vec3) -> Light {

@@ -767,10 +767,8 @@ mod tests {
     #[test]
     fn portable_lanes_match_the_scalar_tracer() {
         let scene = crate::scene::presets::preset("smallpt").and_then(Result::ok).expect("smallpt preset");
-        let mut world = World::new(&scene);
         let camera = CameraModel::new(&scene.camera, 24, 18);
-        let points = world.visible_points(&camera, 24, 18);
-        world.cover(&points, &camera);
+        let (world, _) = World::for_view(&scene, &camera, 24, 18);
         let paths: Vec<(Ray, Sampler)> = (0..24 * 18)
             .map(|pixel| {
                 let mut sampler = Sampler::new(pixel, 0, 3);

@@ -290,6 +290,17 @@ impl World {
             || self.triangles.iter().any(|(t, _)| intersect_triangle(ray, t, t_max).is_some())
     }
 
+    /// The world as a render through `camera` at width × height uses it
+    /// (`cover`ed by what the camera sees), and the size of what it sees
+    /// (`visible_radius`, or the bounds' where it sees nothing).
+    pub fn for_view(scene: &Scene, camera: &CameraModel, width: u32, height: u32) -> (World, f32) {
+        let mut world = World::new(scene);
+        let visible = world.visible_points(camera, width, height);
+        world.cover(&visible, camera);
+        let radius = World::visible_radius(&visible).unwrap_or(world.bounds_radius.max(1.0));
+        (world, radius)
+    }
+
     /// First hits of a grid of primary rays: where the camera looks.
     pub fn visible_points(&self, camera: &CameraModel, width: u32, height: u32) -> Vec<Vec3> {
         const GRID: u32 = 16;
