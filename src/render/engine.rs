@@ -16,7 +16,7 @@ use super::camera::CameraModel;
 use super::image::LinearImage;
 use super::occluders::Occluders;
 use super::path_lanes::PathLanes;
-use super::rng::Sampler;
+use super::rng::{PassStreams, Sampler};
 use super::settings::{Algorithm, RenderSettings};
 use super::tiles::{tile_layout, TileAccumulator, TileRect};
 use super::world::World;
@@ -416,11 +416,16 @@ struct FrameContext<'a> {
 }
 
 impl FrameContext<'_> {
+    /// The streams of sample `sample` of every pixel.
+    fn streams(&self, sample: u64) -> PassStreams {
+        PassStreams::new(sample, self.settings.seed)
+    }
+
     /// The camera ray of one sample of pixel (x, y): jittered within the
     /// pixel, its stream fixed by (pixel, sample, seed).
-    fn camera_ray(&self, x: u32, y: u32, sample: u64) -> (Ray, Sampler) {
+    fn camera_ray(&self, x: u32, y: u32, streams: PassStreams) -> (Ray, Sampler) {
         let pixel = y as u64 * self.settings.width as u64 + x as u64;
-        let mut sampler = Sampler::new(pixel, sample, self.settings.seed);
+        let mut sampler = streams.sampler(pixel);
         let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
         // A pinhole needs no lens sample: its stream keeps two numbers
         let lens = if self.camera.has_lens() { sampler.next_2d() } else { Vec2::ZERO };
@@ -433,12 +438,12 @@ impl FrameContext<'_> {
         &self,
         x: u32,
         y: u32,
-        sample: u64,
+        streams: PassStreams,
         counters: &mut Counters,
         scratch: &mut Option<PhotonScratch>,
     ) -> Option<Rgb> {
         let settings = self.settings;
-        let (ray, mut sampler) = self.camera_ray(x, y, sample);
+        let (ray, mut sampler) = self.camera_ray(x, y, streams);
         let value = match (&self.method, scratch) {
             (Method::Photon(maps), Some(scratch)) => {
                 let renderer = PhotonRenderer {
@@ -484,8 +489,9 @@ impl FrameContext<'_> {
                 sum[c] += value[c] as f64;
             }
         };
+        let streams = self.streams(pass as u64);
         if let Method::PathLanes(lanes) = &self.method {
-            let paths: Vec<(Ray, Sampler)> = pixels.map(|(x, y)| self.camera_ray(x, y, pass as u64)).collect();
+            let paths: Vec<(Ray, Sampler)> = pixels.map(|(x, y)| self.camera_ray(x, y, streams)).collect();
             let mut values = vec![Rgb::ZERO; paths.len()];
             lanes.radiance(&self.world, &paths, self.settings.max_depth, &mut values, counters);
             for (sum, value) in buffer.sums.iter_mut().zip(values) {
@@ -494,7 +500,7 @@ impl FrameContext<'_> {
         } else {
             let mut scratch = self.scratch();
             for (sum, (x, y)) in buffer.sums.iter_mut().zip(pixels) {
-                add(sum, self.sample(x, y, pass as u64, counters, &mut scratch));
+                add(sum, self.sample(x, y, streams, counters, &mut scratch));
             }
             if let Some(scratch) = scratch {
                 counters.queries.add(&scratch.queries);
@@ -520,10 +526,10 @@ impl FrameContext<'_> {
                 if !context.is_current() {
                     return counters;
                 }
-                let rect = buffer.rect;
+                let (rect, streams) = (buffer.rect, self.streams(pass as u64));
                 for (i, pixel) in buffer.sppm.iter_mut().enumerate() {
                     let (x, y) = (rect.x + i as u32 % rect.width, rect.y + i as u32 / rect.width);
-                    let (ray, mut sampler) = self.camera_ray(x, y, pass as u64);
+                    let (ray, mut sampler) = self.camera_ray(x, y, streams);
                     let (direct, visible) =
                         camera_pass(&self.world, &ray, settings.max_depth, &mut sampler, &mut counters);
                     pixel.direct += self.finite(direct, &mut counters).unwrap_or(Rgb::ZERO);
@@ -589,12 +595,12 @@ impl FrameContext<'_> {
                 let value = match self.method {
                     // SPPM has no estimate before its first pass: show direct light
                     Method::Sppm => {
-                        let (ray, mut sampler) = self.camera_ray(x, y, PREVIEW_SAMPLE);
+                        let (ray, mut sampler) = self.camera_ray(x, y, self.streams(PREVIEW_SAMPLE));
                         let direct =
                             camera_pass(&self.world, &ray, self.settings.max_depth, &mut sampler, &mut counters).0;
                         self.finite(direct, &mut counters)
                     }
-                    _ => self.sample(x, y, PREVIEW_SAMPLE, &mut counters, &mut scratch),
+                    _ => self.sample(x, y, self.streams(PREVIEW_SAMPLE), &mut counters, &mut scratch),
                 }
                 .unwrap_or(Rgb::ZERO);
                 for y in by..by + h {

@@ -10,7 +10,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use glam::Vec3;
 
-use super::rng::{mix64, Sampler};
+use super::rng::{mix64, unit_from_24_bits, Sampler};
 
 pub const LANES: usize = 8;
 
@@ -392,11 +392,24 @@ impl Rng8 {
     /// `Sampler::next_f32` in the lanes of `mask` (others: unchanged, value unused).
     #[inline(always)]
     pub fn next_f32(&mut self, mask: M8) -> F8 {
+        let bits = self.next_bits(mask);
+        F8::from_fn(|i| unit_from_24_bits(bits[i] >> 40))
+    }
+
+    /// `Sampler::next_2d` in the lanes of `mask`.
+    #[inline(always)]
+    pub fn next_2d(&mut self, mask: M8) -> (F8, F8) {
+        let bits = self.next_bits(mask);
+        let u0 = F8::from_fn(|i| unit_from_24_bits(bits[i] >> 40));
+        (u0, F8::from_fn(|i| unit_from_24_bits((bits[i] >> 16) & 0xff_ffff)))
+    }
+
+    /// `Sampler::next_u64` in the lanes of `mask`.
+    #[inline(always)]
+    fn next_bits(&mut self, mask: M8) -> [u64; LANES] {
         let advanced: [u64; LANES] = from_fn(|i| Sampler::step(self.state[i]));
-        // 24 bits: exact through i32, which converts in one instruction
-        let value = F8::from_fn(|i| ((mix64(advanced[i]) >> 40) as i32) as f32 * (1.0 / 16_777_216.0));
         self.state = from_fn(|i| if mask.0[i] != 0 { advanced[i] } else { self.state[i] });
-        value
+        from_fn(|i| mix64(advanced[i]))
     }
 }
 
@@ -421,9 +434,12 @@ mod tests {
             // Lanes advance on alternate rounds, by lane parity
             let mask = M8::from_fn(|i| (i + round) % 2 == 0);
             let drawn = rng.next_f32(mask);
+            let pair = rng.next_2d(mask);
             for (lane, s) in samplers.iter_mut().enumerate() {
                 if mask.test(lane) {
                     assert_eq!(drawn.0[lane].to_bits(), s.next_f32().to_bits());
+                    let u = s.next_2d();
+                    assert_eq!((pair.0 .0[lane].to_bits(), pair.1 .0[lane].to_bits()), (u.x.to_bits(), u.y.to_bits()));
                 }
             }
         }

@@ -323,7 +323,7 @@ impl PathLanes {
                 let u_pick = st.rng.next_f32(lambert);
                 std::array::from_fn(|i| ((u_pick.0[i] * light_count as f32) as usize).min(light_count - 1))
             };
-            let u = (st.rng.next_f32(lambert), st.rng.next_f32(lambert));
+            let u = st.rng.next_2d(lambert);
             let light = LightLanes::sample(self, world, &pick, lambert, point, normal, error, u, &hit);
             // f = albedo / π where both directions are above the surface
             let above = !light.wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
@@ -350,7 +350,7 @@ impl PathLanes {
         let mut pdf = F8::splat(1.0);
         let mut scattered = mirror;
         if lambert.any() {
-            let local = cosine_hemisphere((st.rng.next_f32(lambert), st.rng.next_f32(lambert)));
+            let local = cosine_hemisphere(st.rng.next_2d(lambert));
             let w = to_world(from_z(facing), local);
             let cos = w.dot(facing);
             let ok = lambert.and(cos.gt(zero));
