@@ -2,11 +2,11 @@
 //! samples give the same radiance, bit for bit, whatever the lane a path
 //! lands in and however long its neighbours live.
 
-use gi_studio::geometry::Ray;
 use gi_studio::render::camera::CameraModel;
 use gi_studio::render::path;
-use gi_studio::render::path_lanes::PathLanes;
-use gi_studio::render::rng::Sampler;
+use gi_studio::render::path_lanes::{CameraTile, PathLanes};
+use gi_studio::render::rng::PassStreams;
+use gi_studio::render::tiles::TileRect;
 use gi_studio::render::world::World;
 use gi_studio::render::Counters;
 use gi_studio::scene::{presets, Attenuation, Light, LightKind, Rgb, Scene};
@@ -26,40 +26,37 @@ fn world(scene: &Scene, width: u32, height: u32) -> (World, CameraModel) {
     (world, camera)
 }
 
-/// Every pixel's camera sample of one pass, as the engine draws them.
-fn camera_samples(camera: &CameraModel, width: u32, height: u32, pass: u64, seed: u64) -> Vec<(Ray, Sampler)> {
-    (0..height)
-        .flat_map(|y| (0..width).map(move |x| (x, y)))
-        .map(|(x, y)| {
-            let mut sampler = Sampler::new(y as u64 * width as u64 + x as u64, pass, seed);
-            let film = glam::Vec2::new(x as f32, y as f32) + sampler.next_2d();
-            (camera.generate_ray(film, sampler.next_2d()), sampler)
-        })
-        .collect()
-}
-
-/// Lanes against the scalar tracer over `passes` passes; returns how many
-/// samples carried light (so a test cannot pass on a black image).
+/// Lanes against the scalar tracer over `passes` passes of the whole image
+/// (and of one ragged tile off its corner); returns how many samples
+/// carried light (so a test cannot pass on a black image).
 fn assert_lanes_match_scalar(scene: &Scene, max_depth: u32, passes: u64) -> usize {
     let (width, height) = (40, 30);
     let (world, camera) = world(scene, width, height);
     let lanes = PathLanes::new(&world).expect("a scene of spheres");
+    let whole = TileRect { x: 0, y: 0, width, height };
+    // 13 × 7: rows that do not split into eights, away from the origin
+    let ragged = TileRect { x: 21, y: 17, width: 13, height: 7 };
     let mut lit = 0;
     for pass in 0..passes {
-        let samples = camera_samples(&camera, width, height, pass, 7);
-        let mut scalar_counters = Counters::default();
-        let expected: Vec<Rgb> = (samples.iter())
-            .map(|(ray, sampler)| path::radiance(&world, ray, max_depth, &mut sampler.clone(), &mut scalar_counters))
-            .collect();
-        let mut got = vec![Rgb::splat(-1.0); samples.len()];
-        let mut lane_counters = Counters::default();
-        lanes.radiance(&world, &samples, max_depth, &mut got, &mut lane_counters);
-        for (i, (e, g)) in expected.iter().zip(&got).enumerate() {
-            let bits = |v: &Rgb| v.to_array().map(f32::to_bits);
-            assert_eq!(bits(e), bits(g), "sample {i} of pass {pass}: scalar {e} vs lanes {g}");
+        for rect in [whole, ragged] {
+            let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(pass, 7) };
+            let mut scalar_counters = Counters::default();
+            let expected: Vec<Rgb> = (0..tile.len())
+                .map(|i| {
+                    let (ray, mut sampler) = tile.sample(i);
+                    path::radiance(&world, &ray, max_depth, &mut sampler, &mut scalar_counters)
+                })
+                .collect();
+            let mut got = vec![Rgb::splat(-1.0); tile.len()];
+            let mut lane_counters = Counters::default();
+            lanes.radiance(&world, &tile, max_depth, &mut got, &mut lane_counters);
+            for (i, (e, g)) in expected.iter().zip(&got).enumerate() {
+                let bits = |v: &Rgb| v.to_array().map(f32::to_bits);
+                assert_eq!(bits(e), bits(g), "sample {i} of {rect:?}, pass {pass}: scalar {e} vs lanes {g}");
+            }
+            assert_eq!(scalar_counters.rays, lane_counters.rays, "rays traced in pass {pass}");
+            lit += expected.iter().filter(|v| v.max_element() > 0.0).count();
         }
-        assert_eq!(scalar_counters.rays, lane_counters.rays, "rays traced in pass {pass}");
-        lit += expected.iter().filter(|v| v.max_element() > 0.0).count();
     }
     lit
 }
@@ -68,6 +65,16 @@ fn assert_lanes_match_scalar(scene: &Scene, max_depth: u32, passes: u64) -> usiz
 fn smallpt_bit_for_bit() {
     let lit = assert_lanes_match_scalar(&preset("smallpt"), 32, 3);
     assert!(lit > 3000, "only {lit} samples carried light");
+}
+
+/// A thin lens draws its rays one at a time; the lanes take them as they come.
+#[test]
+fn thin_lens_bit_for_bit() {
+    let mut scene = preset("smallpt");
+    scene.camera.aperture_radius = 2.0;
+    scene.camera.focus_distance = 200.0;
+    let lit = assert_lanes_match_scalar(&scene, 32, 1);
+    assert!(lit > 1000, "only {lit} samples carried light");
 }
 
 #[test]

@@ -2,6 +2,8 @@
 
 use glam::{Vec2, Vec3};
 
+use super::lanes::{F8, V8};
+use super::rng::{PassStreams, Sampler};
 use super::sampling::concentric_disk;
 use crate::geometry::Ray;
 use crate::scene::Camera;
@@ -22,6 +24,8 @@ pub struct CameraModel {
     focus_distance: f32,
     width: f32,
     height: f32,
+    /// Pixels in a row, to number them for their random streams.
+    columns: u32,
 }
 
 impl CameraModel {
@@ -50,6 +54,7 @@ impl CameraModel {
             focus_distance,
             width: width as f32,
             height: height as f32,
+            columns: width,
         }
     }
 
@@ -71,6 +76,32 @@ impl CameraModel {
         } else {
             Ray::new(self.position + through * self.near_clip, through.normalize())
         }
+    }
+
+    /// Pixel (x, y)'s camera ray in one pass, with the stream it leaves:
+    /// jittered within the pixel, the stream fixed by (pixel, pass).
+    #[inline]
+    pub fn sample_ray(&self, x: u32, y: u32, streams: PassStreams) -> (Ray, Sampler) {
+        let mut sampler = streams.sampler(self.pixel_index(x, y));
+        let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+        // A pinhole needs no lens sample: its stream keeps two numbers
+        let lens = if self.has_lens() { sampler.next_2d() } else { Vec2::ZERO };
+        (self.generate_ray(film, lens), sampler)
+    }
+
+    /// The number of pixel (x, y), row by row.
+    #[inline(always)]
+    pub(crate) fn pixel_index(&self, x: u32, y: u32) -> u64 {
+        y as u64 * self.columns as u64 + x as u64
+    }
+
+    /// `generate_ray` of a pinhole for eight film positions: (origins, directions).
+    #[inline(always)]
+    pub(crate) fn pinhole_rays(&self, film_x: F8, film_y: F8) -> (V8, V8) {
+        let sx = film_x * self.pixel_size.x - self.half_width;
+        let sy = self.half_height - film_y * self.pixel_size.y;
+        let through = V8::splat(self.forward) + V8::splat(self.right) * sx + V8::splat(self.up) * sy;
+        (V8::splat(self.position) + through * F8::splat(self.near_clip), through.normalize())
     }
 
     /// Whether rays start across a lens (and so need a lens sample).

@@ -9,19 +9,17 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use crossbeam_channel::{Receiver, Sender};
-use glam::Vec2;
 use rayon::prelude::*;
 
 use super::camera::CameraModel;
 use super::image::LinearImage;
 use super::occluders::Occluders;
-use super::path_lanes::PathLanes;
-use super::rng::{PassStreams, Sampler};
+use super::path_lanes::{CameraTile, PathLanes};
+use super::rng::PassStreams;
 use super::settings::{Algorithm, RenderSettings};
 use super::tiles::{tile_layout, TileAccumulator, TileRect};
 use super::world::World;
 use super::{path, whitted, Counters};
-use crate::geometry::Ray;
 use crate::photon::integrator::{PhotonRenderer, PhotonScratch};
 use crate::photon::sppm::camera_pass;
 use crate::photon::trace::{trace_photons, MapKind};
@@ -421,18 +419,6 @@ impl FrameContext<'_> {
         PassStreams::new(sample, self.settings.seed)
     }
 
-    /// The camera ray of one sample of pixel (x, y): jittered within the
-    /// pixel, its stream fixed by (pixel, sample, seed).
-    fn camera_ray(&self, x: u32, y: u32, streams: PassStreams) -> (Ray, Sampler) {
-        let pixel = y as u64 * self.settings.width as u64 + x as u64;
-        let mut sampler = streams.sampler(pixel);
-        let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-        // A pinhole needs no lens sample: its stream keeps two numbers
-        let lens = if self.camera.has_lens() { sampler.next_2d() } else { Vec2::ZERO };
-        let ray = self.camera.generate_ray(film, lens);
-        (ray, sampler)
-    }
-
     /// One finite, non-negative sample (clamped only if asked), or None.
     fn sample(
         &self,
@@ -443,7 +429,7 @@ impl FrameContext<'_> {
         scratch: &mut Option<PhotonScratch>,
     ) -> Option<Rgb> {
         let settings = self.settings;
-        let (ray, mut sampler) = self.camera_ray(x, y, streams);
+        let (ray, mut sampler) = self.camera.sample_ray(x, y, streams);
         let value = match (&self.method, scratch) {
             (Method::Photon(maps), Some(scratch)) => {
                 let renderer = PhotonRenderer {
@@ -491,9 +477,9 @@ impl FrameContext<'_> {
         };
         let streams = self.streams(pass as u64);
         if let Method::PathLanes(lanes) = &self.method {
-            let paths: Vec<(Ray, Sampler)> = pixels.map(|(x, y)| self.camera_ray(x, y, streams)).collect();
-            let mut values = vec![Rgb::ZERO; paths.len()];
-            lanes.radiance(&self.world, &paths, self.settings.max_depth, &mut values, counters);
+            let mut values = vec![Rgb::ZERO; buffer.sums.len()];
+            let tile = CameraTile { camera: &self.camera, rect, streams };
+            lanes.radiance(&self.world, &tile, self.settings.max_depth, &mut values, counters);
             for (sum, value) in buffer.sums.iter_mut().zip(values) {
                 add(sum, self.finite(value, counters));
             }
@@ -529,7 +515,7 @@ impl FrameContext<'_> {
                 let (rect, streams) = (buffer.rect, self.streams(pass as u64));
                 for (i, pixel) in buffer.sppm.iter_mut().enumerate() {
                     let (x, y) = (rect.x + i as u32 % rect.width, rect.y + i as u32 / rect.width);
-                    let (ray, mut sampler) = self.camera_ray(x, y, streams);
+                    let (ray, mut sampler) = self.camera.sample_ray(x, y, streams);
                     let (direct, visible) =
                         camera_pass(&self.world, &ray, settings.max_depth, &mut sampler, &mut counters);
                     pixel.direct += self.finite(direct, &mut counters).unwrap_or(Rgb::ZERO);
@@ -595,7 +581,7 @@ impl FrameContext<'_> {
                 let value = match self.method {
                     // SPPM has no estimate before its first pass: show direct light
                     Method::Sppm => {
-                        let (ray, mut sampler) = self.camera_ray(x, y, self.streams(PREVIEW_SAMPLE));
+                        let (ray, mut sampler) = self.camera.sample_ray(x, y, self.streams(PREVIEW_SAMPLE));
                         let direct =
                             camera_pass(&self.world, &ray, self.settings.max_depth, &mut sampler, &mut counters).0;
                         self.finite(direct, &mut counters)

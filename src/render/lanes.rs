@@ -301,6 +301,18 @@ impl V8 {
         self * (1.0 / self.length())
     }
 
+    /// Component by component, as glam's `Vec3::min`.
+    #[inline(always)]
+    pub fn min(self, o: V8) -> V8 {
+        V8 { x: self.x.min_glam(o.x), y: self.y.min_glam(o.y), z: self.z.min_glam(o.z) }
+    }
+
+    /// Component by component, as glam's `Vec3::max`.
+    #[inline(always)]
+    pub fn max(self, o: V8) -> V8 {
+        V8 { x: self.x.max_glam(o.x), y: self.y.max_glam(o.y), z: self.z.max_glam(o.z) }
+    }
+
     #[inline(always)]
     pub fn abs(self) -> V8 {
         V8 { x: self.x.abs(), y: self.y.abs(), z: self.z.abs() }
@@ -384,9 +396,20 @@ impl Rng8 {
         Rng8 { state: [0; LANES] }
     }
 
+    /// Streams from their `Sampler` states.
     #[inline(always)]
-    pub fn set_lane(&mut self, lane: usize, sampler: &Sampler) {
-        self.state[lane] = sampler.state();
+    pub fn from_states(state: [u64; LANES]) -> Self {
+        Rng8 { state }
+    }
+
+    #[inline(always)]
+    pub fn states(&self) -> [u64; LANES] {
+        self.state
+    }
+
+    #[inline(always)]
+    pub fn set_lane(&mut self, lane: usize, state: u64) {
+        self.state[lane] = state;
     }
 
     /// `Sampler::next_f32` in the lanes of `mask` (others: unchanged, value unused).
@@ -426,10 +449,7 @@ mod tests {
     #[test]
     fn lanes_draw_the_scalar_streams_and_hold_where_masked() {
         let mut samplers: Vec<Sampler> = (0..LANES as u64).map(|i| Sampler::new(i, 3, 9)).collect();
-        let mut rng = Rng8::new();
-        for (lane, s) in samplers.iter().enumerate() {
-            rng.set_lane(lane, s);
-        }
+        let mut rng = Rng8::from_states(std::array::from_fn(|i| samplers[i].state()));
         for round in 0..20 {
             // Lanes advance on alternate rounds, by lane parity
             let mask = M8::from_fn(|i| (i + round) % 2 == 0);

@@ -13,10 +13,12 @@ use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
+use super::camera::CameraModel;
 use super::lanes::{Count8, Rng8, F8, LANES, M8, V8};
 use super::light::{area_pdf, LightSource};
-use super::rng::Sampler;
+use super::rng::{PassStreams, Sampler};
 use super::sampling::{power_heuristic, ROUND_BY_ADDING};
+use super::tiles::TileRect;
 use super::world::{ShapeRef, World};
 use super::Counters;
 use crate::geometry::{gamma, Ray, SurfaceHit};
@@ -164,25 +166,18 @@ impl PathLanes {
         })
     }
 
-    /// The radiance of every camera sample in `paths`, into `out`.
-    pub fn radiance(
-        &self,
-        world: &World,
-        paths: &[(Ray, Sampler)],
-        max_depth: u32,
-        out: &mut [Rgb],
-        counters: &mut Counters,
-    ) {
+    /// The radiance of every camera sample of `tile`, into `out` (one per sample).
+    pub fn radiance(&self, world: &World, tile: &CameraTile, max_depth: u32, out: &mut [Rgb], counters: &mut Counters) {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2, checked just above.
             #[allow(unsafe_code)]
             unsafe {
-                self.radiance_avx2(world, paths, max_depth, out, counters)
+                self.radiance_avx2(world, tile, max_depth, out, counters)
             };
             return;
         }
-        self.radiance_lanes(world, paths, max_depth, out, counters);
+        self.radiance_lanes(world, tile, max_depth, out, counters);
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -190,39 +185,37 @@ impl PathLanes {
     fn radiance_avx2(
         &self,
         world: &World,
-        paths: &[(Ray, Sampler)],
+        tile: &CameraTile,
         max_depth: u32,
         out: &mut [Rgb],
         counters: &mut Counters,
     ) {
-        self.radiance_lanes(world, paths, max_depth, out, counters);
+        self.radiance_lanes(world, tile, max_depth, out, counters);
     }
 
     #[inline(always)]
     fn radiance_lanes(
         &self,
         world: &World,
-        paths: &[(Ray, Sampler)],
+        tile: &CameraTile,
         max_depth: u32,
         out: &mut [Rgb],
         counters: &mut Counters,
     ) {
+        let samples = CameraSamples::new(tile, world);
         let mut state = Lanes::new();
         let mut next = 0;
-        // Camera rays of a tile start close together: mostly all inside the walls
-        let (low, high) = paths.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(low, high), (ray, _)| {
-            (low.min(ray.origin), high.max(ray.origin))
-        });
-        let all_inside = world.walls.hold_box(low, high);
         loop {
             // Idle lanes take the next sample
             for lane in 0..LANES {
-                while !state.active.test(lane) && next < paths.len() {
-                    let (ray, sampler) = &paths[next];
+                while !state.active.test(lane) && next < out.len() {
                     if max_depth == 0 {
                         out[next] = Rgb::ZERO;
                     } else {
-                        state.start(lane, next, ray, sampler, all_inside || world.walls.hold(ray.origin));
+                        let (entry, j) = (next / LANES, next % LANES);
+                        let (origin, direction) = (samples.origin[entry].lane(j), samples.direction[entry].lane(j));
+                        let inside = samples.inside_walls[entry].test(j);
+                        state.start(lane, next, origin, direction, samples.state[entry][j], inside);
                     }
                     next += 1;
                 }
@@ -426,6 +419,118 @@ impl PathLanes {
     }
 }
 
+/// The camera samples of one pass over a tile: pixel (x, y) of `rect`, row
+/// by row, as `CameraModel::sample_ray` draws them.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraTile<'a> {
+    pub camera: &'a CameraModel,
+    pub rect: TileRect,
+    pub streams: PassStreams,
+}
+
+impl CameraTile<'_> {
+    pub fn len(&self) -> usize {
+        (self.rect.width * self.rect.height) as usize
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Sample `i`'s ray and the stream it leaves, drawn one at a time.
+    pub fn sample(&self, i: usize) -> (Ray, Sampler) {
+        let (column, row) = (i as u32 % self.rect.width, i as u32 / self.rect.width);
+        self.camera.sample_ray(self.rect.x + column, self.rect.y + row, self.streams)
+    }
+}
+
+/// A tile's camera samples eight to an entry, as lanes load them (the last
+/// entry repeats the last sample).
+struct CameraSamples {
+    origin: Vec<V8>,
+    direction: Vec<V8>,
+    state: Vec<[u64; LANES]>,
+    /// `Walls::hold` of the origins.
+    inside_walls: Vec<M8>,
+}
+
+impl CameraSamples {
+    #[inline(always)]
+    fn new(tile: &CameraTile, world: &World) -> Self {
+        let mut samples = Self::rays(tile);
+        // Camera rays of a tile start close together: mostly all inside the walls
+        let mut low = samples.origin.first().copied().unwrap_or(V8::splat(Vec3::ZERO));
+        let mut high = low;
+        for &origin in &samples.origin {
+            (low, high) = (V8::min(low, origin), V8::max(high, origin));
+        }
+        let reduce = |v: V8, f: fn(f32, f32) -> f32| {
+            Vec3::new(
+                v.x.0.into_iter().fold(v.x.0[0], f),
+                v.y.0.into_iter().fold(v.y.0[0], f),
+                v.z.0.into_iter().fold(v.z.0[0], f),
+            )
+        };
+        samples.inside_walls = if world.walls.hold_box(reduce(low, f32::min), reduce(high, f32::max)) {
+            vec![M8::ALL; samples.origin.len()]
+        } else {
+            samples.origin.iter().map(|&origin| world.walls.hold_lanes(origin)).collect()
+        };
+        samples
+    }
+
+    /// The rays and their streams.
+    #[inline(always)]
+    fn rays(tile: &CameraTile) -> Self {
+        let entries = tile.len().div_ceil(LANES);
+        let mut samples = CameraSamples {
+            origin: Vec::with_capacity(entries),
+            direction: Vec::with_capacity(entries),
+            state: Vec::with_capacity(entries),
+            inside_walls: Vec::new(),
+        };
+        let last = tile.len().saturating_sub(1);
+        if tile.camera.has_lens() {
+            for entry in 0..entries {
+                let rays: [(Ray, Sampler); LANES] = std::array::from_fn(|i| tile.sample((entry * LANES + i).min(last)));
+                let origin = V8::from_fn(|i| rays[i].0.origin);
+                samples.push(origin, V8::from_fn(|i| rays[i].0.direction), rays.map(|(_, s)| s.state()));
+            }
+            return samples;
+        }
+        // A pinhole's eight at a time: `sample_ray` lane by lane
+        let rect = tile.rect;
+        let (mut x, mut y) = (rect.x, rect.y);
+        for entry in 0..entries {
+            let (mut column, mut row) = ([0; LANES], [0; LANES]);
+            for lane in 0..LANES {
+                (column[lane], row[lane]) = (x, y);
+                if entry * LANES + lane < last {
+                    x += 1;
+                    if x == rect.x + rect.width {
+                        (x, y) = (rect.x, y + 1);
+                    }
+                }
+            }
+            let stream = |i: usize| tile.streams.sampler(tile.camera.pixel_index(column[i], row[i])).state();
+            let mut rng = Rng8::from_states(std::array::from_fn(stream));
+            let (u0, u1) = rng.next_2d(M8::ALL);
+            let film_x = F8::from_fn(|i| column[i] as f32) + u0;
+            let film_y = F8::from_fn(|i| row[i] as f32) + u1;
+            let (origin, direction) = tile.camera.pinhole_rays(film_x, film_y);
+            samples.push(origin, direction, rng.states());
+        }
+        samples
+    }
+
+    #[inline(always)]
+    fn push(&mut self, origin: V8, direction: V8, state: [u64; LANES]) {
+        self.origin.push(origin);
+        self.direction.push(direction);
+        self.state.push(state);
+    }
+}
+
 /// Eight paths in flight.
 struct Lanes {
     active: M8,
@@ -462,19 +567,19 @@ impl Lanes {
     }
 
     #[inline(always)]
-    fn start(&mut self, lane: usize, slot: usize, ray: &Ray, sampler: &Sampler, inside_walls: bool) {
+    fn start(&mut self, lane: usize, slot: usize, origin: Vec3, direction: Vec3, stream: u64, inside_walls: bool) {
         self.active.set(lane, true);
         self.slot[lane] = slot;
         self.depth.0[lane] = 0;
         self.inside_walls.set(lane, inside_walls);
-        self.origin.set_lane(lane, ray.origin);
-        self.direction.set_lane(lane, ray.direction);
+        self.origin.set_lane(lane, origin);
+        self.direction.set_lane(lane, direction);
         self.throughput.set_lane(lane, Rgb::ONE);
         self.radiance.set_lane(lane, Rgb::ZERO);
         self.after_delta.set(lane, true);
         self.last_pdf.0[lane] = 0.0;
-        self.last_point.set_lane(lane, ray.origin);
-        self.rng.set_lane(lane, sampler);
+        self.last_point.set_lane(lane, origin);
+        self.rng.set_lane(lane, stream);
     }
 
     /// Paths of `mask` are done: their radiance goes out, their lanes free up.
@@ -769,20 +874,15 @@ mod tests {
         let scene = crate::scene::presets::preset("smallpt").and_then(Result::ok).expect("smallpt preset");
         let camera = CameraModel::new(&scene.camera, 24, 18);
         let (world, _) = World::for_view(&scene, &camera, 24, 18);
-        let paths: Vec<(Ray, Sampler)> = (0..24 * 18)
-            .map(|pixel| {
-                let mut sampler = Sampler::new(pixel, 0, 3);
-                let film = Vec2::new((pixel % 24) as f32, (pixel / 24) as f32) + sampler.next_2d();
-                (camera.generate_ray(film, sampler.next_2d()), sampler)
-            })
-            .collect();
+        let rect = TileRect { x: 0, y: 0, width: 24, height: 18 };
+        let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(0, 3) };
         let lanes = PathLanes::new(&world).expect("spheres only");
-        let mut got = vec![Rgb::splat(-1.0); paths.len()];
-        lanes.radiance_lanes(&world, &paths, 32, &mut got, &mut Counters::default());
+        let mut got = vec![Rgb::splat(-1.0); tile.len()];
+        lanes.radiance_lanes(&world, &tile, 32, &mut got, &mut Counters::default());
         let mut lit = 0;
-        for ((ray, sampler), got) in paths.iter().zip(&got) {
-            let expected =
-                crate::render::path::radiance(&world, ray, 32, &mut sampler.clone(), &mut Counters::default());
+        for (i, got) in got.iter().enumerate() {
+            let (ray, mut sampler) = tile.sample(i);
+            let expected = crate::render::path::radiance(&world, &ray, 32, &mut sampler, &mut Counters::default());
             assert_eq!(expected.to_array().map(f32::to_bits), got.to_array().map(f32::to_bits));
             lit += (expected.max_element() > 0.0) as usize;
         }
