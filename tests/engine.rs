@@ -93,6 +93,34 @@ fn preview_tiles_come_first_and_cover_the_image() {
     assert!(saw_final_tile);
 }
 
+/// Every tile after every pass when asked (path tracing and SPPM alike),
+/// none otherwise, and the same image either way.
+#[test]
+fn tiles_stream_after_each_pass_only_when_asked() {
+    for algorithm in [Algorithm::Path, Algorithm::Sppm] {
+        let mut images = Vec::new();
+        for stream_tiles in [true, false] {
+            // 64 × 48 in tiles of 32: four tiles, three passes
+            let job = RenderJob { stream_tiles, ..job("cornell", algorithm, 64, 48, 3, 0) };
+            let session = RenderSession::new(None);
+            let generation = session.start(job);
+            let mut tiles = 0;
+            for event in session.events().iter() {
+                match event {
+                    RenderEvent::Tile(tile) if tile.generation == generation => tiles += 1,
+                    RenderEvent::Finished { image, .. } => {
+                        images.push(image);
+                        break;
+                    }
+                    _ => {}
+                }
+            }
+            assert_eq!(tiles, if stream_tiles { 4 * 3 } else { 0 }, "{algorithm}, streaming {stream_tiles}");
+        }
+        assert_eq!(images[0], images[1], "{algorithm}: streaming changed the image");
+    }
+}
+
 #[test]
 fn time_budget_stops_the_render() {
     let mut job = job("cornell", Algorithm::Path, 32, 24, 1, 0);

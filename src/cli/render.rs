@@ -137,6 +137,8 @@ pub fn map_line(name: &str, map: &MapStats) -> String {
 
 /// Render on a session, showing passes (or seconds) on a progress bar.
 pub fn render_with_progress(job: RenderJob) -> Result<RenderOutcome> {
+    // Only the final image is written
+    let job = RenderJob { stream_tiles: false, ..job };
     let settings = job.settings.clone();
     let bar = match (settings.samples_per_pixel, settings.time_limit) {
         (_, Some(seconds)) => ProgressBar::new((seconds * 10.0).ceil() as u64),

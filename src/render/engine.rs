@@ -34,11 +34,14 @@ pub struct RenderJob {
     /// Photon maps made earlier for this scene and these settings (loaded
     /// from a file); traced afresh when absent.
     pub photon_maps: Option<Arc<PhotonMaps>>,
+    /// Send every tile's image after each pass (what a viewport or a
+    /// convergence log reads); a batch render wants only the final image.
+    pub stream_tiles: bool,
 }
 
 impl RenderJob {
     pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Self {
-        Self { scene, settings, photon_maps: None }
+        Self { scene, settings, photon_maps: None, stream_tiles: true }
     }
 }
 
@@ -232,6 +235,7 @@ fn worker_loop(
         if let Some((_, pool)) = &pools {
             let context = JobContext {
                 generation: job_generation,
+                stream_tiles: job.stream_tiles,
                 current: &generation,
                 events: &events,
                 notify: notify.as_ref(),
@@ -243,6 +247,7 @@ fn worker_loop(
 
 struct JobContext<'a> {
     generation: u64,
+    stream_tiles: bool,
     current: &'a AtomicU64,
     events: &'a Sender<RenderEvent>,
     notify: Option<&'a Notify>,
@@ -251,6 +256,19 @@ struct JobContext<'a> {
 impl JobContext<'_> {
     fn is_current(&self) -> bool {
         self.current.load(Ordering::Relaxed) == self.generation
+    }
+
+    /// A tile's image after a pass, if the job streams them.
+    fn send_tile(&self, buffer: &TileAccumulator) {
+        if self.stream_tiles {
+            let pixels = buffer.mean();
+            self.send(RenderEvent::Tile(TileUpdate {
+                generation: self.generation,
+                rect: buffer.rect,
+                pixels,
+                preview: false,
+            }));
+        }
     }
 
     fn send(&self, event: RenderEvent) {
@@ -349,12 +367,7 @@ fn run_job(context: &JobContext, job: &RenderJob) {
                     let mut counters = Counters::default();
                     if context.is_current() {
                         frame.render_tile_pass(buffer, pass, &mut counters);
-                        context.send(RenderEvent::Tile(TileUpdate {
-                            generation,
-                            rect: buffer.rect,
-                            pixels: buffer.mean(),
-                            preview: false,
-                        }));
+                        context.send_tile(buffer);
                     }
                     counters
                 })
@@ -554,12 +567,7 @@ impl FrameContext<'_> {
                     sum += pixel.radius as f64;
                 }
                 buffer.samples += 1;
-                context.send(RenderEvent::Tile(TileUpdate {
-                    generation: context.generation,
-                    rect: buffer.rect,
-                    pixels: buffer.mean(),
-                    preview: false,
-                }));
+                context.send_tile(buffer);
                 (sum, buffer.sppm.len())
             })
             .collect();
@@ -604,7 +612,7 @@ impl FrameContext<'_> {
 /// want just the image (and the final statistics).
 pub fn render_blocking(job: &RenderJob) -> Result<(LinearImage, PassStats), String> {
     let session = RenderSession::new(None);
-    let generation = session.start(job.clone());
+    let generation = session.start(RenderJob { stream_tiles: false, ..job.clone() });
     for event in session.events().iter() {
         match event {
             RenderEvent::Finished { generation: g, image, stats } if g == generation => {
