@@ -49,13 +49,23 @@ pub struct LightSample {
     pub shadow_t_max: f32,
     /// The triangle the sample lies on: its shadow ray meets that plane only at its end.
     pub on_triangle: Option<u32>,
+    /// The sphere the sample lies on (facing the point): its shadow ray meets it only at its end.
+    pub on_sphere: Option<u32>,
 }
 
 impl LightSample {
     /// From a delta light: an infinite pdf, no surface under the sample.
     #[inline]
     fn delta(shadow: Ray, shadow_t_max: f32, value: Rgb) -> Self {
-        LightSample { wi: shadow.direction, value, pdf: f32::INFINITY, shadow, shadow_t_max, on_triangle: None }
+        LightSample {
+            wi: shadow.direction,
+            value,
+            pdf: f32::INFINITY,
+            shadow,
+            shadow_t_max,
+            on_triangle: None,
+            on_sphere: None,
+        }
     }
 }
 
@@ -106,9 +116,10 @@ impl LightSource {
                 if normal.dot(-shadow.direction) <= 0.0 || pdf.is_nan() || pdf <= 0.0 {
                     return None;
                 }
-                let on_triangle = match world.objects[object as usize].shape {
-                    ShapeRef::Triangle(t) => Some(t),
-                    _ => None,
+                let (on_triangle, on_sphere) = match world.objects[object as usize].shape {
+                    ShapeRef::Triangle(t) => (Some(t), None),
+                    ShapeRef::Sphere(i) => (None, Some(i)),
+                    ShapeRef::Plane(_) => (None, None),
                 };
                 Some(LightSample {
                     wi: shadow.direction,
@@ -117,6 +128,7 @@ impl LightSource {
                     shadow,
                     shadow_t_max,
                     on_triangle,
+                    on_sphere,
                 })
             }
         }

@@ -6,6 +6,8 @@
 //!   box's five planes), the shadow rays of paths from inside skip it.
 //! - Triangles in the plane of the light's triangle (its own, the other half
 //!   of a quad): a shadow ray ends in that plane and meets it nowhere else.
+//! - The light's own sphere: a sample faces the point, and a ball lies behind
+//!   its tangent plane there, so the shadow ray meets it only at its end.
 
 use glam::{DVec3, Vec3};
 
@@ -143,7 +145,8 @@ impl Walls {
         }
         let centers: Vec<Vec3> = others.iter().map(|&j| s.center(j)).collect();
         let radii: Vec<f32> = others.iter().map(|&j| s.radius[j]).collect();
-        Walls { regions, spheres: SphereLanes::new(&centers, &radii), planes, is_wall_sphere }
+        let ids = others.iter().map(|&j| j as u32).collect();
+        Walls { regions, spheres: SphereLanes::new(&centers, &radii, ids), planes, is_wall_sphere }
     }
 
     /// Whether a path starting at `origin` is inside every wall (and there are walls).
@@ -255,7 +258,7 @@ impl<'w> Occluders<'w> {
         let (ray, t_max) = (&sample.shadow, sample.shadow_t_max);
         let world = self.world;
         let light_plane = sample.on_triangle.map(|t| world.light_plane[t as usize]);
-        self.spheres.any_hit(ray, t_max)
+        self.spheres.any_hit_except(ray, t_max, sample.on_sphere)
             || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
             || world.triangles.iter().zip(&world.light_plane).any(|((triangle, _), plane)| {
                 light_plane != Some(*plane) && intersect_triangle(ray, triangle, t_max).is_some()
@@ -266,7 +269,7 @@ impl<'w> Occluders<'w> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Ray;
+    use crate::geometry::{sphere_t, Ray};
     use crate::render::camera::CameraModel;
     use crate::render::rng::Sampler;
     use crate::render::sampling::uniform_sphere;
@@ -478,9 +481,13 @@ mod tests {
                                     && intersect_triangle(shadow, triangle, t_max).is_some()
                             })
                         });
+                        let own_sphere = sample.on_sphere.is_some_and(|i| {
+                            sphere_t(shadow, w.spheres.center(i as usize), w.spheres.radius[i as usize], t_max)
+                                .is_some()
+                        });
                         let target = shadow.origin.as_dvec3() + shadow.direction.as_dvec3() * t_max as f64;
                         assert!(
-                            own_plane || on_a_wall(&w.walls, target),
+                            own_plane || own_sphere || on_a_wall(&w.walls, target),
                             "{name}: a blocker skipped in the open, target {target}"
                         );
                     }

@@ -88,6 +88,9 @@ impl CapLight {
 struct Occluder {
     center: Vec3,
     radius2: f32,
+    /// Its index in the world, if a light lies on it: that light's shadow
+    /// rays skip it (`occluders`: they meet it only at their end).
+    emitter: Option<u32>,
 }
 
 /// A world compiled for eight-lane path tracing.
@@ -99,6 +102,8 @@ pub struct PathLanes {
     others: Vec<Occluder>,
     walls: Vec<Occluder>,
     lights: Vec<Option<CapLight>>,
+    /// The sphere each light lies on, if any.
+    light_spheres: Vec<Option<u32>>,
     background: Rgb,
 }
 
@@ -154,14 +159,28 @@ impl PathLanes {
                 _ => None,
             })
             .collect();
+        let light_spheres: Vec<Option<u32>> = (world.lights.iter())
+            .map(|light| match *light {
+                LightSource::Area { object, .. } => match world.objects[object as usize].shape {
+                    ShapeRef::Sphere(i) => Some(i),
+                    _ => None,
+                },
+                _ => None,
+            })
+            .collect();
         let is_wall = |i: usize| world.walls.is_wall_sphere.get(i).copied().unwrap_or(false);
-        let occluder = |i: usize| Occluder { center: spheres[i].center, radius2: spheres[i].radius2 };
+        let occluder = |i: usize| Occluder {
+            center: spheres[i].center,
+            radius2: spheres[i].radius2,
+            emitter: light_spheres.contains(&Some(i as u32)).then_some(i as u32),
+        };
         let (walls, others) = (0..spheres.len()).partition::<Vec<_>, _>(|&i| is_wall(i));
         Some(PathLanes {
             others: others.into_iter().map(occluder).collect(),
             walls: walls.into_iter().map(occluder).collect(),
             spheres,
             lights,
+            light_spheres,
             background: world.background,
         })
     }
@@ -324,7 +343,7 @@ impl PathLanes {
             let shade = light.valid.and(above).and(f.nonzero());
             counters.rays += shade.count();
             if shade.any() {
-                let blocked = self.blocked(shade, st.inside_walls, light.origin, light.wi, light.t_max);
+                let blocked = self.blocked(shade, st.inside_walls, light.origin, light.wi, light.t_max, &pick);
                 let lit = shade.and_not(blocked);
                 if lit.any() {
                     let cos = light.wi.dot(facing);
@@ -403,11 +422,17 @@ impl PathLanes {
     /// Lanes of `mask` whose shadow ray (origin, unit direction, t_max) is
     /// blocked by a sphere; paths inside every wall skip the walls.
     #[inline(always)]
-    fn blocked(&self, mask: M8, inside_walls: M8, origin: V8, direction: V8, t_max: F8) -> M8 {
+    fn blocked(&self, mask: M8, inside_walls: M8, origin: V8, direction: V8, t_max: F8, pick: &[usize; LANES]) -> M8 {
         let mut blocked = M8::NONE;
         // Plain loops: a closure here would not inherit AVX2
         for sphere in &self.others {
-            blocked = blocked.or(roots(origin, direction, sphere.center, sphere.radius2, t_max).1);
+            let aimed_at = match sphere.emitter {
+                // Every sample lies on the one light: no shadow ray can meet it
+                Some(_) if self.light_spheres.len() == 1 => continue,
+                Some(id) => M8::from_fn(|i| self.light_spheres[pick[i]] == Some(id)),
+                None => M8::NONE,
+            };
+            blocked = blocked.or(roots(origin, direction, sphere.center, sphere.radius2, t_max).1.and_not(aimed_at));
         }
         let outside = mask.and_not(inside_walls);
         if outside.any() {

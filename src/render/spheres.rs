@@ -16,11 +16,13 @@ pub struct SphereLanes {
     center_y: Vec<Vec4>,
     center_z: Vec<Vec4>,
     radius2: Vec<Vec4>,
-    count: usize,
+    /// Which sphere of the world each lane holds, in order.
+    ids: Vec<u32>,
 }
 
 impl SphereLanes {
-    pub fn new(centers: &[Vec3], radii: &[f32]) -> Self {
+    /// Spheres `ids` of the world, with these centres and radii.
+    pub fn new(centers: &[Vec3], radii: &[f32], ids: Vec<u32>) -> Self {
         let groups = centers.len().div_ceil(4);
         let lane = |i: usize, f: &dyn Fn(usize) -> f32| {
             Vec4::from_array([0, 1, 2, 3].map(|k| if i * 4 + k < centers.len() { f(i * 4 + k) } else { EMPTY }))
@@ -30,16 +32,16 @@ impl SphereLanes {
             center_y: (0..groups).map(|i| lane(i, &|j| centers[j].y)).collect(),
             center_z: (0..groups).map(|i| lane(i, &|j| centers[j].z)).collect(),
             radius2: (0..groups).map(|i| lane(i, &|j| radii[j] * radii[j])).collect(),
-            count: centers.len(),
+            ids,
         }
     }
 
     pub fn len(&self) -> usize {
-        self.count
+        self.ids.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.count == 0
+        self.ids.is_empty()
     }
 
     /// Per lane of one group: the nearest root in (0, t_max), infinity where
@@ -103,6 +105,20 @@ impl SphereLanes {
         let limit = Vec4::splat(t_max);
         self.groups().any(|(cx, cy, cz, r2)| Self::group(cx, cy, cz, r2, ray, limit).0.cmplt(limit).any())
     }
+
+    /// `any_hit` but for the world's sphere `except`.
+    #[inline]
+    pub fn any_hit_except(&self, ray: &Ray, t_max: f32, except: Option<u32>) -> bool {
+        let Some(skip) = except.and_then(|id| self.ids.iter().position(|&i| i == id)) else {
+            return self.any_hit(ray, t_max);
+        };
+        let limit = Vec4::splat(t_max);
+        self.groups().enumerate().any(|(g, (cx, cy, cz, r2))| {
+            let hits = Self::group(cx, cy, cz, r2, ray, limit).0.cmplt(limit).bitmask();
+            let skipped = if skip / 4 == g { 1 << (skip % 4) } else { 0 };
+            hits & !skipped != 0
+        })
+    }
 }
 
 #[cfg(test)]
@@ -119,7 +135,7 @@ mod tests {
         for count in [1usize, 3, 4, 5, 9, 13] {
             let centers: Vec<Vec3> = (0..count).map(|_| uniform_sphere(s.next_2d()) * 5.0).collect();
             let radii: Vec<f32> = (0..count).map(|_| 0.2 + s.next_f32()).collect();
-            let lanes = SphereLanes::new(&centers, &radii);
+            let lanes = SphereLanes::new(&centers, &radii, (0..count as u32).collect());
             for _ in 0..2000 {
                 let ray = Ray::new(uniform_sphere(s.next_2d()) * 8.0 * s.next_f32(), uniform_sphere(s.next_2d()));
                 let t_max = if s.next_f32() < 0.3 { 4.0 } else { f32::INFINITY };
@@ -131,6 +147,10 @@ mod tests {
                 }
                 assert_eq!(lanes.nearest(&ray, t_max), expected);
                 assert_eq!(lanes.any_hit(&ray, t_max), expected.is_some());
+                // Without one sphere: whether any other lies on the ray
+                let except = s.next_u64() as usize % count;
+                let others = (0..count).any(|i| i != except && sphere_t(&ray, centers[i], radii[i], t_max).is_some());
+                assert_eq!(lanes.any_hit_except(&ray, t_max, Some(except as u32)), others);
             }
         }
     }

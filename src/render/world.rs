@@ -181,7 +181,8 @@ impl World {
             world.objects.push(ObjectInfo { shape, material, light: None });
         }
         let centers: Vec<Vec3> = (0..world.spheres.radius.len()).map(|i| world.spheres.center(i)).collect();
-        world.spheres.lanes = SphereLanes::new(&centers, &world.spheres.radius);
+        let ids = (0..centers.len() as u32).collect();
+        world.spheres.lanes = SphereLanes::new(&centers, &world.spheres.radius, ids);
         if lo.x <= hi.x {
             world.bounds_center = (lo + hi) * 0.5;
             world.bounds_radius = (hi - lo).length() * 0.5;
