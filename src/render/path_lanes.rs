@@ -138,27 +138,7 @@ impl PathLanes {
                 })
             })
             .collect::<Option<Vec<_>>>()?;
-        let lights = (world.lights.iter())
-            .map(|light| match *light {
-                LightSource::Area { object, radiance } => match world.objects[object as usize].shape {
-                    ShapeRef::Sphere(i) => {
-                        let cap = world.emitting_cap(i as usize);
-                        let info = &spheres[i as usize];
-                        (!cap.is_whole()).then(|| CapLight {
-                            center: info.center,
-                            radius: info.radius,
-                            error: info.error,
-                            frame: [cap.frame.x, cap.frame.y, cap.frame.z],
-                            one_minus_cos: cap.one_minus_cos,
-                            area: cap.area(info.radius),
-                            radiance,
-                        })
-                    }
-                    _ => None,
-                },
-                _ => None,
-            })
-            .collect();
+        // The sphere each light lies on, and the cap the lanes sample of it
         let light_spheres: Vec<Option<u32>> = (world.lights.iter())
             .map(|light| match *light {
                 LightSource::Area { object, .. } => match world.objects[object as usize].shape {
@@ -166,6 +146,22 @@ impl PathLanes {
                     _ => None,
                 },
                 _ => None,
+            })
+            .collect();
+        let lights = (world.lights.iter().zip(&light_spheres))
+            .map(|(light, sphere)| {
+                let (&LightSource::Area { radiance, .. }, &Some(i)) = (light, sphere) else { return None };
+                let cap = world.emitting_cap(i as usize);
+                let info = &spheres[i as usize];
+                (!cap.is_whole()).then(|| CapLight {
+                    center: info.center,
+                    radius: info.radius,
+                    error: info.error,
+                    frame: [cap.frame.x, cap.frame.y, cap.frame.z],
+                    one_minus_cos: cap.one_minus_cos,
+                    area: cap.area(info.radius),
+                    radiance,
+                })
             })
             .collect();
         let is_wall = |i: usize| world.walls.is_wall_sphere.get(i).copied().unwrap_or(false);
