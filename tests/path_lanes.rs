@@ -9,7 +9,7 @@ use gi_studio::render::rng::PassStreams;
 use gi_studio::render::tiles::TileRect;
 use gi_studio::render::world::World;
 use gi_studio::render::Counters;
-use gi_studio::scene::{presets, Attenuation, Light, LightKind, Rgb, Scene};
+use gi_studio::scene::{presets, Attenuation, Light, LightKind, MaterialModel, Rgb, Scene};
 use glam::Vec3;
 
 fn light(kind: LightKind, intensity: f32) -> Light {
@@ -105,6 +105,30 @@ fn other_lights_bit_for_bit() {
     assert_lanes_match_scalar(&scene, 32, 2);
     scene.lights.push(light(LightKind::Directional { direction: Vec3::new(0.1, -1.0, 0.3) }, 1.0));
     assert_lanes_match_scalar(&scene, 32, 1);
+}
+
+/// A path off a black surface can carry no more light: it ends there (one
+/// ray a sample), not after the bounces before Russian roulette may end it.
+#[test]
+fn paths_end_on_black_surfaces() {
+    let mut scene = preset("smallpt");
+    for material in &mut scene.materials {
+        if !matches!(material.model, MaterialModel::Emissive { .. }) {
+            material.model = MaterialModel::Lambert { albedo: Rgb::ZERO };
+        }
+    }
+    let (world, camera) = world(&scene, 40, 30);
+    let rect = TileRect { x: 0, y: 0, width: 40, height: 30 };
+    let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(0, 7) };
+    let mut counters = Counters::default();
+    for i in 0..tile.len() {
+        let (ray, mut sampler) = tile.sample(i);
+        path::radiance(&world, &ray, 32, &mut sampler, &mut counters);
+    }
+    assert_eq!(counters.rays, tile.len() as u64);
+    // The lanes trace as many rays (the helper compares the counts)
+    let lit = assert_lanes_match_scalar(&scene, 32, 1);
+    assert!(lit > 0, "the light is in view");
 }
 
 #[test]

@@ -82,9 +82,14 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
         last_pdf = scattered.pdf;
         last_point = hit.surface.point;
 
+        // A path that can carry no more light (off a black surface) ends
+        // now, not at the roulette: the bounces after it would add nothing
+        let survive = throughput.max_element().min(0.95);
+        if survive <= 0.0 {
+            break;
+        }
         if depth + 1 >= ROULETTE_DEPTH {
-            let survive = throughput.max_element().min(0.95);
-            if survive <= 0.0 || sampler.next_f32() >= survive {
+            if sampler.next_f32() >= survive {
                 break;
             }
             throughput /= survive;

@@ -396,16 +396,16 @@ impl PathLanes {
         st.last_pdf = go.select(pdf, st.last_pdf);
         st.last_point = go.select_v(point, st.last_point);
 
-        // Russian roulette after the first bounces
-        let roulette = st.depth.ge(ROULETTE_DEPTH - 1).and(go);
-        let mut killed = M8::NONE;
+        // Paths that can carry no more light end now; Russian roulette
+        // after the first bounces
+        let survive = st.throughput.max_element().min(F8::splat(0.95));
+        let mut killed = go.and(survive.le(zero));
+        let roulette = st.depth.ge(ROULETTE_DEPTH - 1).and(go).and_not(killed);
         if roulette.any() {
-            let survive = st.throughput.max_element().min(F8::splat(0.95));
-            let hopeless = roulette.and(survive.le(zero));
-            let draw = roulette.and_not(hopeless);
-            let u = st.rng.next_f32(draw);
-            killed = hopeless.or(draw.and(u.ge(survive)));
-            let kept = roulette.and_not(killed);
+            let u = st.rng.next_f32(roulette);
+            let stop = roulette.and(u.ge(survive));
+            let kept = roulette.and_not(stop);
+            killed = killed.or(stop);
             st.throughput = kept.select_v(st.throughput / survive, st.throughput);
         }
         let go = go.and_not(killed);
