@@ -376,6 +376,7 @@ mod tests {
     /// the f32 test cannot call it, and a NaN.
     #[test]
     fn walls_hold_lanes_as_they_hold_points() {
+        assert!(crate::render::lanes::supported(), "the lanes need AVX2");
         let w = world(&preset("smallpt"));
         let mut s = Sampler::new(4, 5, 6);
         let (low, high) = (Vec3::new(-1.0, -1.0, -1.0), Vec3::new(101.0, 83.0, 172.0));
@@ -392,7 +393,9 @@ mod tests {
                 p
             });
             let mut origins = V8::from_fn(|i| points[i]);
-            origins.x.0[7] = if s.next_f32() < 0.1 { f32::NAN } else { origins.x.0[7] };
+            if s.next_f32() < 0.1 {
+                origins.x.set_lane(7, f32::NAN);
+            }
             let lanes = w.walls.hold_lanes(origins);
             for lane in 0..LANES {
                 assert_eq!(lanes.test(lane), w.walls.hold(origins.lane(lane)), "{}", origins.lane(lane));

@@ -14,7 +14,7 @@ use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_4, PI};
 use glam::{Vec2, Vec3};
 
 use super::camera::CameraModel;
-use super::lanes::{Count8, Rng8, F8, LANES, M8, V8};
+use super::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
 use super::light::{area_pdf, LightSource};
 use super::rng::{PassStreams, Sampler};
 use super::sampling::{power_heuristic, ROUND_BY_ADDING};
@@ -183,15 +183,16 @@ impl PathLanes {
 
     /// The radiance of every camera sample of `tile`, into `out` (one per sample).
     pub fn radiance(&self, world: &World, tile: &CameraTile, max_depth: u32, out: &mut [Rgb], counters: &mut Counters) {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2, checked just above.
-            #[allow(unsafe_code)]
-            unsafe {
-                self.radiance_avx2(world, tile, max_depth, out, counters)
-            };
-            return;
+        if !lanes::supported() {
+            return one_by_one(world, tile, max_depth, out, counters);
         }
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: the CPU has AVX2 (`lanes::supported`).
+        #[allow(unsafe_code)]
+        unsafe {
+            self.radiance_avx2(world, tile, max_depth, out, counters)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
         self.radiance_lanes(world, tile, max_depth, out, counters);
     }
 
@@ -217,37 +218,40 @@ impl PathLanes {
         out: &mut [Rgb],
         counters: &mut Counters,
     ) {
+        if max_depth == 0 {
+            out.fill(Rgb::ZERO);
+            return;
+        }
         let samples = CameraSamples::new(tile, world);
         let mut state = Lanes::new();
+        // Which sample each lane traces: apart from the lanes' registers, as
+        // indexing it by lane would keep them all in memory
+        let mut slots = [0; LANES];
         let mut next = 0;
         loop {
-            // Idle lanes take the next sample
-            for lane in 0..LANES {
-                while !state.active.test(lane) && next < out.len() {
-                    if max_depth == 0 {
-                        out[next] = Rgb::ZERO;
-                    } else {
-                        let (entry, j) = (next / LANES, next % LANES);
-                        let (origin, direction) = (samples.origin[entry].lane(j), samples.direction[entry].lane(j));
-                        let inside = samples.inside_walls[entry].test(j);
-                        state.start(lane, next, origin, direction, samples.state[entry][j], inside);
-                    }
-                    next += 1;
-                }
-            }
+            state.start_idle(&samples, &mut slots, &mut next, out.len());
             if !state.active.any() {
                 return;
             }
-            self.bounce(world, &mut state, max_depth, out, counters);
+            self.bounce(world, &mut state, &slots, max_depth, out, counters);
         }
     }
 
     /// One bounce of every active path: `path::radiance`'s loop body. The
     /// paths that end here hand their radiance out.
     #[inline(always)]
-    fn bounce(&self, world: &World, st: &mut Lanes, max_depth: u32, out: &mut [Rgb], counters: &mut Counters) {
+    #[allow(clippy::too_many_arguments)]
+    fn bounce(
+        &self,
+        world: &World,
+        st: &mut Lanes,
+        slots: &[usize; LANES],
+        max_depth: u32,
+        out: &mut [Rgb],
+        counters: &mut Counters,
+    ) {
         let done = self.bounce_live(world, st, max_depth, counters);
-        st.finish(done, out);
+        st.finish(done, slots, out);
     }
 
     /// `bounce` short of handing out: returns the lanes whose paths ended.
@@ -278,7 +282,10 @@ impl PathLanes {
         if !alive.any() {
             return missed;
         }
-        let sphere: [&SphereInfo; LANES] = std::array::from_fn(|i| &self.spheres[index.0[i] as usize]);
+        let sphere: [&SphereInfo; LANES] = {
+            let index = index.truncate();
+            lanes::each(|i| &self.spheres[index[i] as usize])
+        };
         let code = F8::from_fn(|i| sphere[i].kind);
         let kind = |k: Kind| code.eq(k.code()).and(alive);
         let (lambert, mirror, glass, emissive) =
@@ -300,8 +307,12 @@ impl PathLanes {
         let normal = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
         let point = center + normal * radius;
         let wo = -direction;
-        let hit =
-            |i: usize| SurfaceHit { t: t_hit.0[i], point: point.lane(i), normal: normal.lane(i), error: error.0[i] };
+        let hit = |i: usize| SurfaceHit {
+            t: t_hit.lane(i),
+            point: point.lane(i),
+            normal: normal.lane(i),
+            error: error.lane(i),
+        };
 
         // Emission reached by this ray, weighted against light sampling (rare: lane by lane)
         let light_count = world.lights.len();
@@ -311,7 +322,7 @@ impl PathLanes {
             let object = sphere[lane].object;
             let weight = match world.objects[object as usize].light {
                 Some(_) if !st.after_delta.test(lane) => power_heuristic(
-                    st.last_pdf.0[lane],
+                    st.last_pdf.lane(lane),
                     pick_pdf * area_pdf(world, object, st.last_point.lane(lane), &hit(lane)),
                 ),
                 _ => 1.0,
@@ -329,7 +340,8 @@ impl PathLanes {
                 [0; LANES]
             } else {
                 let u_pick = st.rng.next_f32(lambert);
-                std::array::from_fn(|i| ((u_pick.0[i] * light_count as f32) as usize).min(light_count - 1))
+                let u_pick = u_pick.to_array();
+                lanes::each(|i| ((u_pick[i] * light_count as f32) as usize).min(light_count - 1))
             };
             let u = st.rng.next_2d(lambert);
             let light = LightLanes::sample(self, world, &pick, lambert, point, normal, error, u, &hit);
@@ -372,7 +384,8 @@ impl PathLanes {
             let eta_i = entering.select(F8::splat(1.0), ior);
             let eta_t = entering.select(ior, F8::splat(1.0));
             let eta = eta_i / eta_t;
-            let cos_i = wo.dot(facing).map(|c| c.clamp(0.0, 1.0));
+            // `clamp(0, 1)`, NaN kept
+            let cos_i = F8::splat(1.0).min(zero.max(wo.dot(facing)));
             let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
             let total = sin2_t.ge(F8::splat(1.0));
             let cos_t = (1.0 - sin2_t).sqrt();
@@ -440,6 +453,14 @@ impl PathLanes {
     }
 }
 
+/// Without lanes (a CPU without AVX2): the scalar tracer, sample by sample.
+fn one_by_one(world: &World, tile: &CameraTile, max_depth: u32, out: &mut [Rgb], counters: &mut Counters) {
+    for (i, value) in out.iter_mut().enumerate() {
+        let (ray, mut sampler) = tile.sample(i);
+        *value = super::path::radiance(world, &ray, max_depth, &mut sampler, counters);
+    }
+}
+
 /// The camera samples of one pass over a tile: pixel (x, y) of `rect`, row
 /// by row, as `CameraModel::sample_ray` draws them.
 #[derive(Clone, Copy, Debug)]
@@ -465,38 +486,37 @@ impl CameraTile<'_> {
     }
 }
 
-/// A tile's camera samples eight to an entry, as lanes load them (the last
-/// entry repeats the last sample).
-struct CameraSamples {
-    origin: Vec<V8>,
-    direction: Vec<V8>,
-    state: Vec<[u64; LANES]>,
-    /// `Walls::hold` of the origins.
-    inside_walls: Vec<M8>,
+/// One camera sample, as a lane takes it up.
+#[derive(Clone, Copy, Debug)]
+struct CameraSample {
+    origin: Vec3,
+    direction: Vec3,
+    stream: u64,
+    /// `Walls::hold` of the origin.
+    inside_walls: bool,
 }
+
+/// A tile's camera samples, a whole number of eights (the last eight repeat
+/// the last sample).
+struct CameraSamples(Vec<CameraSample>);
 
 impl CameraSamples {
     #[inline(always)]
     fn new(tile: &CameraTile, world: &World) -> Self {
         let mut samples = Self::rays(tile);
         // Camera rays of a tile start close together: mostly all inside the walls
-        let mut low = samples.origin.first().copied().unwrap_or(V8::splat(Vec3::ZERO));
-        let mut high = low;
-        for &origin in &samples.origin {
-            (low, high) = (V8::min(low, origin), V8::max(high, origin));
+        let (mut low, mut high) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for sample in &samples.0 {
+            (low, high) = (low.min(sample.origin), high.max(sample.origin));
         }
-        let reduce = |v: V8, f: fn(f32, f32) -> f32| {
-            Vec3::new(
-                v.x.0.into_iter().fold(v.x.0[0], f),
-                v.y.0.into_iter().fold(v.y.0[0], f),
-                v.z.0.into_iter().fold(v.z.0[0], f),
-            )
-        };
-        samples.inside_walls = if world.walls.hold_box(reduce(low, f32::min), reduce(high, f32::max)) {
-            vec![M8::ALL; samples.origin.len()]
-        } else {
-            samples.origin.iter().map(|&origin| world.walls.hold_lanes(origin)).collect()
-        };
+        if !world.walls.hold_box(low, high) {
+            for entry in samples.0.chunks_exact_mut(LANES) {
+                let held = world.walls.hold_lanes(V8::from_fn(|i| entry[i].origin)).to_array();
+                for (sample, held) in entry.iter_mut().zip(held) {
+                    sample.inside_walls = held != 0;
+                }
+            }
+        }
         samples
     }
 
@@ -504,16 +524,11 @@ impl CameraSamples {
     #[inline(always)]
     fn rays(tile: &CameraTile) -> Self {
         let entries = tile.len().div_ceil(LANES);
-        let mut samples = CameraSamples {
-            origin: Vec::with_capacity(entries),
-            direction: Vec::with_capacity(entries),
-            state: Vec::with_capacity(entries),
-            inside_walls: Vec::new(),
-        };
+        let mut samples = CameraSamples(Vec::with_capacity(entries * LANES));
         let last = tile.len().saturating_sub(1);
         if tile.camera.has_lens() {
             for entry in 0..entries {
-                let rays: [(Ray, Sampler); LANES] = std::array::from_fn(|i| tile.sample((entry * LANES + i).min(last)));
+                let rays: [(Ray, Sampler); LANES] = lanes::each(|i| tile.sample((entry * LANES + i).min(last)));
                 let origin = V8::from_fn(|i| rays[i].0.origin);
                 samples.push(origin, V8::from_fn(|i| rays[i].0.direction), rays.map(|(_, s)| s.state()));
             }
@@ -534,7 +549,7 @@ impl CameraSamples {
                 }
             }
             let stream = |i: usize| tile.streams.sampler(tile.camera.pixel_index(column[i], row[i])).state();
-            let mut rng = Rng8::from_states(std::array::from_fn(stream));
+            let mut rng = Rng8::from_states(lanes::each(stream));
             let (u0, u1) = rng.next_2d(M8::ALL);
             let film_x = F8::from_fn(|i| column[i] as f32) + u0;
             let film_y = F8::from_fn(|i| row[i] as f32) + u1;
@@ -544,18 +559,25 @@ impl CameraSamples {
         samples
     }
 
+    /// Eight samples, taken to be inside the walls until `new` knows better.
     #[inline(always)]
-    fn push(&mut self, origin: V8, direction: V8, state: [u64; LANES]) {
-        self.origin.push(origin);
-        self.direction.push(direction);
-        self.state.push(state);
+    fn push(&mut self, origin: V8, direction: V8, stream: [u64; LANES]) {
+        let (ox, oy, oz) = (origin.x.to_array(), origin.y.to_array(), origin.z.to_array());
+        let (dx, dy, dz) = (direction.x.to_array(), direction.y.to_array(), direction.z.to_array());
+        for i in 0..LANES {
+            self.0.push(CameraSample {
+                origin: Vec3::new(ox[i], oy[i], oz[i]),
+                direction: Vec3::new(dx[i], dy[i], dz[i]),
+                stream: stream[i],
+                inside_walls: true,
+            });
+        }
     }
 }
 
 /// Eight paths in flight.
 struct Lanes {
     active: M8,
-    slot: [usize; LANES],
     depth: Count8,
     inside_walls: M8,
     origin: V8,
@@ -573,8 +595,7 @@ impl Lanes {
         let zero = V8::splat(Vec3::ZERO);
         Lanes {
             active: M8::NONE,
-            slot: [0; LANES],
-            depth: Count8([0; LANES]),
+            depth: Count8::ZERO,
             inside_walls: M8::NONE,
             origin: zero,
             direction: zero,
@@ -587,29 +608,55 @@ impl Lanes {
         }
     }
 
+    /// Idle lanes take the next samples (from `next` on, below `count`),
+    /// all at once: a blend per field, where a lane at a time would store
+    /// and reload every field's register.
     #[inline(always)]
-    fn start(&mut self, lane: usize, slot: usize, origin: Vec3, direction: Vec3, stream: u64, inside_walls: bool) {
-        self.active.set(lane, true);
-        self.slot[lane] = slot;
-        self.depth.0[lane] = 0;
-        self.inside_walls.set(lane, inside_walls);
-        self.origin.set_lane(lane, origin);
-        self.direction.set_lane(lane, direction);
-        self.throughput.set_lane(lane, Rgb::ONE);
-        self.radiance.set_lane(lane, Rgb::ZERO);
-        self.after_delta.set(lane, true);
-        self.last_pdf.0[lane] = 0.0;
-        self.last_point.set_lane(lane, origin);
-        self.rng.set_lane(lane, stream);
+    fn start_idle(&mut self, samples: &CameraSamples, slots: &mut [usize; LANES], next: &mut usize, count: usize) {
+        let (mut idle, mut started) = ((!self.active).bits(), 0);
+        let mut states = self.rng.states();
+        while idle != 0 && *next < count {
+            let lane = idle.trailing_zeros() as usize;
+            idle &= idle - 1;
+            started |= 1 << lane;
+            slots[lane] = *next;
+            states[lane] = samples.0[*next].stream;
+            *next += 1;
+        }
+        if started == 0 {
+            return;
+        }
+        let started = M8::from_bits(started);
+        let taken: [&CameraSample; LANES] = lanes::each(|i| &samples.0[slots[i]]);
+        let origin = V8::from_fn(|i| taken[i].origin);
+        let inside_walls = M8::from_fn(|i| taken[i].inside_walls);
+        self.active = self.active.or(started);
+        self.depth = self.depth.reset(started);
+        self.inside_walls = started.select_mask(inside_walls, self.inside_walls);
+        self.origin = started.select_v(origin, self.origin);
+        self.direction = started.select_v(V8::from_fn(|i| taken[i].direction), self.direction);
+        self.throughput = started.select_v(V8::splat(Rgb::ONE), self.throughput);
+        self.radiance = started.select_v(V8::splat(Rgb::ZERO), self.radiance);
+        self.after_delta = self.after_delta.or(started);
+        self.last_pdf = started.select(F8::splat(0.0), self.last_pdf);
+        self.last_point = started.select_v(origin, self.last_point);
+        self.rng = Rng8::from_states(states);
     }
 
     /// Paths of `mask` are done: their radiance goes out, their lanes free up.
     #[inline(always)]
-    fn finish(&mut self, mask: M8, out: &mut [Rgb]) {
-        for lane in (0..LANES).filter(|&i| mask.test(i)) {
-            out[self.slot[lane]] = self.radiance.lane(lane);
-            self.active.set(lane, false);
+    fn finish(&mut self, mask: M8, slots: &[usize; LANES], out: &mut [Rgb]) {
+        let mut done = mask.bits();
+        if done == 0 {
+            return;
         }
+        let (x, y, z) = (self.radiance.x.to_array(), self.radiance.y.to_array(), self.radiance.z.to_array());
+        while done != 0 {
+            let lane = done.trailing_zeros() as usize;
+            done &= done - 1;
+            out[slots[lane]] = Rgb::new(x[lane], y[lane], z[lane]);
+        }
+        self.active = self.active.and_not(mask);
     }
 }
 
@@ -698,7 +745,7 @@ impl LightLanes {
                 _ => {
                     // Lanes without a cap compute on the first cap, unused
                     let first = lanes.lights.iter().flatten().next().unwrap_or(&CapLight::NONE);
-                    CapLanes::gather(std::array::from_fn(|i| cap(i).unwrap_or(first)))
+                    CapLanes::gather(lanes::each(|i| cap(i).unwrap_or(first)))
                 }
             };
             let CapLanes { center, radius, error: light_error, frame, one_minus_cos, area, radiance } = caps;
@@ -722,15 +769,15 @@ impl LightLanes {
         let others = if all_caps { M8::NONE } else { mask.and_not(cap_lanes) };
         for lane in (0..LANES).filter(|&i| others.test(i)) {
             let light = &world.lights[pick[lane]];
-            let u = Vec2::new(u.0 .0[lane], u.1 .0[lane]);
+            let u = Vec2::new(u.0.lane(lane), u.1.lane(lane));
             if let Some(sample) = light.sample(world, &hit(lane), u) {
                 out.valid.set(lane, true);
                 out.delta.set(lane, light.is_delta());
                 out.wi.set_lane(lane, sample.wi);
                 out.value.set_lane(lane, sample.value);
-                out.pdf.0[lane] = sample.pdf;
+                out.pdf.set_lane(lane, sample.pdf);
                 out.origin.set_lane(lane, sample.shadow.origin);
-                out.t_max.0[lane] = sample.shadow_t_max;
+                out.t_max.set_lane(lane, sample.shadow_t_max);
             }
         }
         out
@@ -746,9 +793,9 @@ fn solve(f: V8, direction: V8, radius2: F8) -> (F8, F8, F8) {
     let l = f - direction * b;
     let discriminant = radius2 - l.length_squared();
     let c = f.length_squared() - radius2;
-    let q = -b - discriminant.max_glam(F8::splat(0.0)).sqrt().copysign(b);
+    let q = -b - discriminant.max(F8::splat(0.0)).sqrt().copysign(b);
     let t0 = c / q;
-    (t0.min_glam(q), t0.max_glam(q), discriminant)
+    (t0.min(q), t0.max(q), discriminant)
 }
 
 /// Per lane, the nearest root t of the sphere and whether it lies in
@@ -773,7 +820,7 @@ fn power_heuristic8(pdf_f: F8, pdf_g: F8) -> F8 {
     let (f, g) = (pdf_f * pdf_f, pdf_g * pdf_g);
     let sum = f + g;
     let degenerate = sum.eq(F8::splat(0.0)).or(!f.is_finite());
-    let fallback = pdf_f.map(|p| if p.is_infinite() { 1.0 } else { 0.0 });
+    let fallback = pdf_f.abs().eq(F8::splat(f32::INFINITY)).select(F8::splat(1.0), F8::splat(0.0));
     degenerate.select(fallback, f / sum)
 }
 
@@ -787,7 +834,7 @@ fn fresnel_dielectric(cos_i: F8, cos_t: F8, eta_i: F8, eta_t: F8) -> F8 {
 /// `Frame::from_z` in lanes: [x, y, z].
 #[inline(always)]
 fn from_z(z: V8) -> [V8; 3] {
-    let sign = z.z.map(|v| 1.0f32.copysign(v));
+    let sign = F8::splat(1.0).copysign(z.z);
     let a = -1.0 / (sign + z.z);
     let b = z.x * z.y * a;
     let x = V8 { x: 1.0 + sign * z.x * z.x * a, y: sign * b, z: -sign * z.x };
@@ -808,12 +855,13 @@ fn sin_cos(x: F8) -> (F8, F8) {
     const PI_2_LO: f32 = 7.549_79e-8;
     let shifted = x * FRAC_2_PI + ROUND_BY_ADDING;
     let quadrant = shifted - ROUND_BY_ADDING;
-    let k: [u32; LANES] = shifted.0.map(f32::to_bits);
     let r = ((x - quadrant * PI_2_HI) - quadrant * PI_2_MID) - quadrant * PI_2_LO;
     let (sin, cos) = sin_cos_reduced(r);
-    let swap = M8::from_fn(|i| k[i] & 1 != 0);
-    let sin_negative = M8::from_fn(|i| k[i] & 2 != 0);
-    let cos_negative = M8::from_fn(|i| (k[i] + 1) & 2 != 0);
+    // The quadrant k sits in the low bits of `shifted`: cos is negative
+    // where bit 1 of k + 1 is set, that is where k's two low bits differ
+    let swap = shifted.bits_set(1);
+    let sin_negative = shifted.bits_set(2);
+    let cos_negative = swap.xor(sin_negative);
     let (s, c) = (swap.select(cos, sin), swap.select(sin, cos));
     (sin_negative.select(-s, s), cos_negative.select(-c, c))
 }
@@ -839,7 +887,7 @@ fn cosine_hemisphere(u: (F8, F8)) -> V8 {
     // oy / ox where wide, ox / oy elsewhere, as the smaller magnitude over
     // the larger with the quotient's sign (bit for bit the same): a division
     // of selected lanes was split into lane-by-lane branches
-    let ratio = (ax.min_glam(ay) / ax.max_glam(ay)).copysign(ox * oy);
+    let ratio = (ax.min(ay) / ax.max(ay)).copysign(ox * oy);
     let (sin, cos) = sin_cos_reduced(FRAC_PI_4 * ratio);
     let dx = centre.select(zero, r * wide.select(cos, sin));
     let dy = centre.select(zero, r * wide.select(sin, cos));
@@ -870,7 +918,7 @@ fn solid_angle_pdf(p: V8, point: V8, normal: V8, area: F8) -> F8 {
 #[inline(always)]
 fn spawn_offset_scale(p: V8) -> F8 {
     let m = p.abs().max_element().max(F8::splat(f32::MIN_POSITIVE));
-    let ulp = m.map(|m| f32::from_bits((m.to_bits() & 0x7f80_0000).saturating_sub(23 << 23)).max(f32::from_bits(1)));
+    let ulp = m.binade_ulp().max(F8::splat(f32::from_bits(1)));
     ulp * 256.0
 }
 
@@ -887,26 +935,24 @@ mod tests {
     use super::*;
     use crate::render::camera::CameraModel;
 
-    /// The portable build of the lanes (the one CPUs without AVX2 run) gives
-    /// the scalar tracer's samples too; `tests/path_lanes.rs` covers the
-    /// dispatched one.
+    /// What a CPU without AVX2 renders: the scalar tracer's samples, the
+    /// lanes' bit for bit (`tests/path_lanes.rs` holds the lanes to the
+    /// scalar tracer at length).
     #[test]
-    fn portable_lanes_match_the_scalar_tracer() {
+    fn without_lanes_the_samples_are_the_same() {
         let scene = crate::scene::presets::preset("smallpt").and_then(Result::ok).expect("smallpt preset");
         let camera = CameraModel::new(&scene.camera, 24, 18);
         let (world, _) = World::for_view(&scene, &camera, 24, 18);
         let rect = TileRect { x: 0, y: 0, width: 24, height: 18 };
         let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(0, 3) };
         let lanes = PathLanes::new(&world).expect("spheres only");
-        let mut got = vec![Rgb::splat(-1.0); tile.len()];
-        lanes.radiance_lanes(&world, &tile, 32, &mut got, &mut Counters::default());
-        let mut lit = 0;
-        for (i, got) in got.iter().enumerate() {
-            let (ray, mut sampler) = tile.sample(i);
-            let expected = crate::render::path::radiance(&world, &ray, 32, &mut sampler, &mut Counters::default());
-            assert_eq!(expected.to_array().map(f32::to_bits), got.to_array().map(f32::to_bits));
-            lit += (expected.max_element() > 0.0) as usize;
-        }
-        assert!(lit > 200, "{lit} samples carried light");
+        let (mut got, mut expected) = (vec![Rgb::splat(-1.0); tile.len()], vec![Rgb::splat(-2.0); tile.len()]);
+        let (mut lane_counters, mut scalar_counters) = (Counters::default(), Counters::default());
+        lanes.radiance(&world, &tile, 32, &mut got, &mut lane_counters);
+        one_by_one(&world, &tile, 32, &mut expected, &mut scalar_counters);
+        let bits = |v: &[Rgb]| v.iter().map(|c| c.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+        assert_eq!(bits(&got), bits(&expected));
+        assert_eq!(lane_counters.rays, scalar_counters.rays);
+        assert!(expected.iter().filter(|v| v.max_element() > 0.0).count() > 200, "samples carried light");
     }
 }
