@@ -5,7 +5,7 @@ pub mod bsdf;
 pub mod camera;
 pub mod engine;
 pub mod image;
-pub mod lanes;
+pub(crate) mod lanes;
 pub mod light;
 pub mod occluders;
 pub mod path;

@@ -276,7 +276,7 @@ impl Count8 {
     // SAFETY: any bit pattern is a valid __m256i
     pub const ZERO: Count8 = Count8(unsafe { std::mem::transmute::<[u32; LANES], __m256i>([0; LANES]) });
 
-    #[inline(always)]
+    #[cfg(test)]
     pub fn from_array(v: [u32; LANES]) -> Self {
         let v = v.map(|c| c as i32);
         Count8(unsafe { _mm256_setr_epi32(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]) })

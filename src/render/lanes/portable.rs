@@ -221,12 +221,13 @@ impl Not for M8 {
 impl Count8 {
     pub const ZERO: Count8 = Count8([0; LANES]);
 
-    #[inline(always)]
+    // For the test against the intrinsics
+    #[cfg(all(test, target_arch = "x86_64"))]
     pub fn to_array(self) -> [u32; LANES] {
         self.0
     }
 
-    #[inline(always)]
+    #[cfg(all(test, target_arch = "x86_64"))]
     pub fn from_array(v: [u32; LANES]) -> Self {
         Count8(v)
     }
