@@ -93,13 +93,15 @@ impl F8 {
         self.abs().lt(F8::splat(f32::INFINITY))
     }
 
-    /// MINPS: `self < other ? self : other`.
+    /// MINPS: `self < other ? self : other`, glam's `min`; and `f32::min`
+    /// against a number never NaN, as LLVM compiles the scalar tracer's.
     #[inline(always)]
     pub fn min(self, other: F8) -> Self {
         F8(unsafe { _mm256_min_ps(self.0, other.0) })
     }
 
-    /// MAXPS: `self > other ? self : other`.
+    /// MAXPS: `self > other ? self : other`, glam's `max`; and `f32::max`
+    /// against a number never NaN (`x.max(0.0)`), as LLVM compiles it.
     #[inline(always)]
     pub fn max(self, other: F8) -> Self {
         F8(unsafe { _mm256_max_ps(self.0, other.0) })
