@@ -6,7 +6,8 @@
 //! with AVX2. `path_lanes` builds lanes only inside its AVX2 entry point,
 //! entered after `is_x86_feature_detected!("avx2")`; other CPUs render with
 //! the scalar tracer. The tests that use the lanes directly check the CPU
-//! first.
+//! first, and `lanes` is private to the crate, so nothing outside can
+//! make one.
 #![allow(unsafe_code)]
 
 use std::arch::x86_64::*;
