@@ -170,18 +170,6 @@ impl V8 {
         self * (1.0 / self.length())
     }
 
-    /// Component by component, as glam's `Vec3::min`.
-    #[inline(always)]
-    pub fn min(self, o: V8) -> V8 {
-        V8 { x: self.x.min(o.x), y: self.y.min(o.y), z: self.z.min(o.z) }
-    }
-
-    /// Component by component, as glam's `Vec3::max`.
-    #[inline(always)]
-    pub fn max(self, o: V8) -> V8 {
-        V8 { x: self.x.max(o.x), y: self.y.max(o.y), z: self.z.max(o.z) }
-    }
-
     #[inline(always)]
     pub fn abs(self) -> V8 {
         V8 { x: self.x.abs(), y: self.y.abs(), z: self.z.abs() }
