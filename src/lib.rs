@@ -6,7 +6,9 @@
 pub mod analysis;
 pub mod app;
 pub mod cli;
+pub mod fileio;
 pub mod geometry;
+pub mod limits;
 pub mod photon;
 pub mod render;
 pub mod scene;

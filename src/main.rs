@@ -3,7 +3,21 @@
 use std::process::ExitCode;
 
 use clap::Parser;
-use gi_studio::cli::{Cli, Command};
+use gi_studio::app::StudioArgs;
+use gi_studio::cli::Command;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "gi-studio",
+    version,
+    about = "A studio for global illumination: Whitted ray tracing, path tracing, photon mapping and progressive photon mapping side by side."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    studio: StudioArgs,
+}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -12,7 +26,7 @@ fn main() -> ExitCode {
         Some(Command::Photons(args)) => gi_studio::cli::photons::run(args),
         Some(Command::Reference(args)) => gi_studio::cli::reference::run(args),
         Some(Command::Bench(args)) => gi_studio::cli::bench::run(args),
-        None => gi_studio::app::run(cli.studio.clone()),
+        None => gi_studio::app::run(cli.studio),
     };
     // Errors are reported once, here, as a user reads them (no backtrace)
     match result {

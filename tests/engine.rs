@@ -48,7 +48,7 @@ fn every_preset_renders_finite_with_both_algorithms() {
 
 #[test]
 fn restart_abandons_the_old_job_and_only_the_new_one_finishes() {
-    let session = RenderSession::new(None);
+    let session = RenderSession::new(None).unwrap();
     let mut slow = job("smallpt", Algorithm::Path, 256, 192, 10_000, 0);
     slow.settings.samples_per_pixel = None;
     let old = session.start(slow);
@@ -71,7 +71,7 @@ fn restart_abandons_the_old_job_and_only_the_new_one_finishes() {
 fn preview_tiles_come_first_and_cover_the_image() {
     let mut job = job("thesis", Algorithm::Path, 64, 48, 1, 0);
     job.settings.preview = true;
-    let session = RenderSession::new(None);
+    let session = RenderSession::new(None).unwrap();
     let generation = session.start(job);
     let mut preview_pixels = 0;
     let mut saw_final_tile = false;
@@ -102,7 +102,7 @@ fn tiles_stream_after_each_pass_only_when_asked() {
         for stream_tiles in [true, false] {
             // 64 × 48 in tiles of 32: four tiles, three passes
             let job = RenderJob { stream_tiles, ..job("cornell", algorithm, 64, 48, 3, 0) };
-            let session = RenderSession::new(None);
+            let session = RenderSession::new(None).unwrap();
             let generation = session.start(job);
             let mut tiles = 0;
             for event in session.events().iter() {

@@ -646,7 +646,7 @@ fn case_17_sppm_thousands_of_passes() {
     let scene = presets::preset("cornell").unwrap().unwrap();
     let mut s = settings(Algorithm::Sppm, 4, 3, 2000);
     s.photon.sppm_photons_per_pass = 500;
-    let session = gi_studio::render::RenderSession::new(None);
+    let session = gi_studio::render::RenderSession::new(None).unwrap();
     let generation = session.start(RenderJob::new(Arc::new(scene), s));
     let mut last_radius = f32::INFINITY;
     for event in session.events().iter() {

@@ -92,7 +92,7 @@ fn sppm_error_keeps_falling() {
     let reference = render(&scene, settings(Algorithm::Path, 40, 30, 4096));
     let mut sppm = settings(Algorithm::Sppm, 40, 30, 64);
     sppm.photon.sppm_photons_per_pass = 20_000;
-    let session = RenderSession::new(None);
+    let session = RenderSession::new(None).unwrap();
     let generation = session.start(RenderJob::new(Arc::new(scene), sppm));
     let mut errors = Vec::new();
     let mut current = LinearImage::new(40, 30);
@@ -190,6 +190,72 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
     assert!(matches!(load_photon_maps(&dir.join("short.pmap"), scene_key, key), Err(PhotonFileError::Damaged { .. })));
 }
 
+/// A map's body is checked before anything renders with it, each kind of
+/// damage with its own message: a flipped bit anywhere (the checksum), and,
+/// in a file whose checksum was made to match, a photon count larger than
+/// the file (refused before allocating for it), a photon that is not
+/// finite, a tree out of order and a gather radius that is not a radius.
+#[test]
+fn damaged_photon_maps_are_refused_each_with_its_own_message() {
+    let scene = presets::preset("caustics").unwrap().unwrap();
+    let mut s = settings(Algorithm::Photon, 32, 24, 1);
+    s.photon.global_photons = 2_000;
+    s.photon.caustic_photons = 2_000;
+    let camera = CameraModel::new(&scene.camera, s.width, s.height);
+    let (world, visible) = World::for_view(&scene, &camera, s.width, s.height);
+    let maps = PhotonMaps::build(&world, &s.photon, s.seed, s.max_depth, visible);
+    assert!(maps.global.len() > 100);
+    let dir = std::env::temp_dir().join(format!("gi-pmap-damage-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (scene_key, key) = (scene.content_key(), settings_key(&s.photon, s.seed, s.max_depth));
+    let good = dir.join("good.pmap");
+    save_photon_maps(&maps, scene_key, key, &good).unwrap();
+    let bytes = std::fs::read(&good).unwrap();
+    let load = |name: &str, bytes: &[u8]| {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        match load_photon_maps(&path, scene_key, key) {
+            Err(PhotonFileError::Damaged { reason, .. }) => reason,
+            Err(other) => panic!("{name}: expected a damaged map, got {other}"),
+            Ok(_) => panic!("{name}: a damaged map was accepted"),
+        }
+    };
+    // The body starts after the 32-byte header and the global map's 16-byte counts
+    let (header, body) = (32, 48);
+    for at in [header - 4, body, body + 13, bytes.len() / 2, bytes.len() - 9] {
+        let mut flipped = bytes.clone();
+        flipped[at] ^= 0x10;
+        assert!(load(&format!("flip{at}.pmap"), &flipped).contains("checksum"), "byte {at}");
+    }
+    let resealed = |mut b: Vec<u8>| {
+        let end = b.len() - 8;
+        let sum = gi_studio::photon::file::checksum(&b[..end]);
+        b[end..].copy_from_slice(&sum.to_le_bytes());
+        b
+    };
+    let mut huge = bytes.clone();
+    huge[header + 8..header + 16].copy_from_slice(&(1u64 << 34).to_le_bytes());
+    assert!(load("huge.pmap", &resealed(huge)).contains("claims 17179869184 photons"));
+    let mut nan = bytes.clone();
+    nan[body + 28 * 7 + 4..body + 28 * 7 + 8].copy_from_slice(&f32::NAN.to_le_bytes());
+    assert_eq!(load("nan.pmap", &resealed(nan)), "photon 7 of the global map has a position that is not finite");
+    let mut negative = bytes.clone();
+    negative[body + 12..body + 16].copy_from_slice(&(-1.0f32).to_le_bytes());
+    assert!(load("negative.pmap", &resealed(negative)).contains("power that is negative"));
+    // Swap the root's two children: each lands on the wrong side of the root's split
+    let mut swapped = bytes.clone();
+    let (a, b) = (body + 28, body + 56);
+    let first: Vec<u8> = swapped[a..a + 28].to_vec();
+    swapped.copy_within(b..b + 28, a);
+    swapped[b..b + 28].copy_from_slice(&first);
+    assert!(load("order.pmap", &resealed(swapped)).contains("out of the tree's order"));
+    let mut radius = bytes.clone();
+    radius[header - 4..header].copy_from_slice(&f32::INFINITY.to_le_bytes());
+    assert!(load("radius.pmap", &resealed(radius)).contains("gather radius is inf"));
+    assert!(load("extra.pmap", &[bytes.as_slice(), &[0]].concat()).contains("checksum belong"));
+    load_photon_maps(&good, scene_key, key).expect("the untouched file still loads");
+}
+
 /// smallpt's light is a sphere of radius 600 of which only a cap 0.27 deep
 /// shows below the ceiling: photons leave from that cap alone. The power
 /// they carry must still be right: SPPM's image has the reference's mean
@@ -201,7 +267,7 @@ fn a_light_larger_than_the_scene_delivers_the_right_power() {
     let reference = LinearImage::load(std::path::Path::new(&path)).unwrap().downsample(8);
     let mut s = settings(Algorithm::Sppm, reference.width, reference.height, 64);
     s.photon.sppm_photons_per_pass = 50_000;
-    let session = RenderSession::new(None);
+    let session = RenderSession::new(None).unwrap();
     let generation = session.start(RenderJob::new(Arc::new(scene), s));
     let mut image = LinearImage::new(reference.width, reference.height);
     let mut errors = Vec::new();

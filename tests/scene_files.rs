@@ -158,3 +158,34 @@ fn syntax_and_unknown_field_errors_have_positions() {
     let message = e.to_string();
     assert!(matches!(e, SceneFileError::Syntax { .. }) && message.contains("fov_degrees"), "{message}");
 }
+
+/// A typo inside a shape, a material or a light is an error naming the
+/// field and its line, not a default silently rendered.
+#[test]
+fn unknown_fields_inside_shapes_materials_and_lights_are_refused() {
+    for (text, from, to, field) in [
+        (CORNELL, "radius: 0.35), material: \"mirror\"", "radus: 0.35), material: \"mirror\"", "radus"),
+        (CORNELL, "ior: 1.5", "ior: 1.5, tnit: (1.0, 1.0, 1.0)", "tnit"),
+        (LIGHTS, "cone_angle_degrees: 25.0", "cone_angle_degrees: 25.0, falof: 2.0", "falof"),
+        (LIGHTS, "intensity: 12.0)", "intensity: 12.0, attenuation: (a: 1.0, d: 2.0))", "d"),
+    ] {
+        let e = broken(text, from, to);
+        let message = e.to_string();
+        let edited = text.replacen(from, to, 1);
+        match e {
+            SceneFileError::Syntax { line, .. } => assert_eq!(line, line_of(&edited, to), "{message}"),
+            other => panic!("expected a syntax error for {field}, got {other}"),
+        }
+        assert!(message.contains(&format!("`{field}`")), "{message}");
+    }
+}
+
+#[test]
+fn exposure_and_size_beyond_their_limits_are_refused() {
+    let e = broken(CORNELL, "exposure: 0.0", "exposure: 1e30");
+    assert_invalid(e, "settings.exposure", line_of(CORNELL, "exposure"), |p| matches!(p, Problem::OutOfRange { .. }));
+    let e = broken(CORNELL, "width: 640, height: 480", "width: 16384, height: 16384");
+    assert_invalid(e, "settings.height", line_of(CORNELL, "width: 640"), |p| {
+        matches!(p, Problem::TooManyPixels { width: 16384, height: 16384 })
+    });
+}

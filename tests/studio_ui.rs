@@ -3,11 +3,12 @@
 use std::path::PathBuf;
 
 use eframe::egui;
+use eframe::Storage as _;
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
+use gi_studio::app::StudioArgs;
 use gi_studio::app::{Selection, StudioApp};
-use gi_studio::cli::StudioArgs;
 use gi_studio::render::camera::CameraModel;
 use gi_studio::scene::Shape;
 
@@ -235,4 +236,95 @@ fn layout_is_restored_and_an_unsaved_scene_is_offered_back() {
     harness.run_steps(2);
     assert_eq!(harness.state().scene, edited);
     assert!(!harness.state().offers_autosave());
+}
+
+fn autosaved_storage(edited: &gi_studio::scene::Scene) -> MemoryStorage {
+    let mut storage = MemoryStorage::default();
+    storage.set_string("autosave_scene", gi_studio::scene::to_ron(edited).unwrap());
+    storage
+}
+
+fn edited_cornell() -> gi_studio::scene::Scene {
+    let mut scene = gi_studio::scene::presets::default_scene();
+    scene.camera.fov_y_degrees = 61.0;
+    scene
+}
+
+/// After a crash the autosave is offered back; until the user answers, the
+/// studio's own saves must keep it (a second crash must not lose it), and
+/// only a Discard clears it.
+#[test]
+fn an_unanswered_autosave_offer_keeps_the_autosave() {
+    let edited = edited_cornell();
+    let mut storage = autosaved_storage(&edited);
+    let autosave = storage.get_string("autosave_scene");
+    let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &StudioArgs::default());
+    assert!(app.offers_autosave());
+    eframe::App::save(&mut app, &mut storage);
+    assert_eq!(storage.get_string("autosave_scene"), autosave, "the unanswered offer's autosave was replaced");
+    let mut harness =
+        Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app);
+    harness.run_steps(2);
+    harness.get_by_label("Discard").click();
+    harness.run_steps(2);
+    eframe::App::save(harness.state_mut(), &mut storage);
+    assert_eq!(storage.get_string("autosave_scene").as_deref(), Some(""));
+}
+
+/// A `--screenshot` run (CI's, the README's) saves nothing: not the layout,
+/// not the autosave, whatever it renders.
+#[test]
+fn a_screenshot_run_never_touches_the_saved_state() {
+    let edited = edited_cornell();
+    let mut storage = autosaved_storage(&edited);
+    storage.set_string("studio", "(panes: [], show_plots: false)".into());
+    let before = storage.0.clone();
+    let args = StudioArgs { screenshot: Some(PathBuf::from("shot.png")), panes: Some(4), ..Default::default() };
+    let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &args);
+    assert!(!app.offers_autosave());
+    app.scene.camera.fov_y_degrees = 20.0;
+    eframe::App::save(&mut app, &mut storage);
+    assert_eq!(storage.0, before);
+}
+
+/// Saved settings no render can use (a pane of 100000², k = 2³²−1, 100000
+/// threads, tiles of 0, a NaN exposure) fall back to defaults with a notice;
+/// the studio starts and renders.
+#[test]
+fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
+    let mut storage = MemoryStorage::default();
+    let broken = gi_studio::render::RenderSettings {
+        width: 100_000,
+        height: 100_000,
+        threads: 100_000,
+        tile_size: 0,
+        photon: gi_studio::render::PhotonSettings { k_nearest: u32::MAX, ..Default::default() },
+        ..Default::default()
+    };
+    let fine =
+        gi_studio::render::RenderSettings { width: 64, height: 48, samples_per_pixel: Some(1), ..Default::default() };
+    let saved = gi_studio::app::Persisted {
+        panes: vec![broken, fine.clone()],
+        exposures: vec![f32::NAN, 1.0],
+        show_plots: false,
+        recent: Vec::new(),
+    };
+    storage.set_string("studio", ron::to_string(&saved).unwrap());
+    let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &StudioArgs::default());
+    assert_eq!(app.panes.len(), 2);
+    let first = &app.panes[0].settings;
+    assert!(first.problems().is_empty(), "{:?}", first.problems());
+    assert!(first.width <= 4096 && first.threads == 0 && first.tile_size == 32);
+    assert_eq!(app.panes[1].settings, fine);
+    assert_eq!((app.panes[0].exposure, app.panes[1].exposure), (0.0, 1.0));
+    assert!(app.status.contains("pane 1's saved size") && app.status.contains("exposure"), "{}", app.status);
+    for pane in &mut app.panes {
+        pane.settings.width = 32;
+        pane.settings.height = 24;
+        pane.settings.samples_per_pixel = Some(1);
+    }
+    app.restart_all();
+    let mut harness =
+        Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app);
+    step_until(&mut harness, |app| app.panes.iter().all(|p| p.state.finished));
 }

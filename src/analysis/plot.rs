@@ -73,6 +73,5 @@ pub fn plot_error_against_time(title: &str, series: &[(String, ConvergenceLog)],
             .map_err(|e| e.to_string())?;
         root.present().map_err(|e| e.to_string())?;
     }
-    image::save_buffer(path, &rgb, width, height, image::ExtendedColorType::Rgb8)
-        .map_err(|e| format!("{}: {e}", path.display()))
+    crate::render::image::save_png(path, width, height, false, &rgb).map_err(|e| e.to_string())
 }

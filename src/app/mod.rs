@@ -1,6 +1,7 @@
 //! The studio window (eframe/egui). It depends on every layer below; none
 //! depends on it. It reaches the engine only through `RenderSession`s.
 
+mod capture;
 mod export;
 mod files;
 mod history;
@@ -8,6 +9,7 @@ mod inspector;
 mod menu;
 mod pane;
 mod plots;
+mod storage;
 mod studio;
 mod viewport;
 
@@ -16,10 +18,45 @@ pub use pane::{Pane, PaneState, PassRecord};
 pub use studio::{Action, Persisted, StudioApp};
 pub use viewport::pick;
 
-use crate::cli::StudioArgs;
+use std::path::PathBuf;
+
+use clap::Args;
+
+/// Options of the studio window (the binary without a subcommand).
+#[derive(Debug, Args, Default, Clone)]
+pub struct StudioArgs {
+    /// Open this scene file instead of the built-in Cornell box.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Number of viewport panes (1, 2 or 4).
+    #[arg(long, value_parser = parse_panes)]
+    pub panes: Option<usize>,
+    /// Save a PNG screenshot of the window here once the panes have
+    /// rendered `--quit-after-passes` passes, then exit (for CI and the
+    /// README). Such a run saves no settings and touches no autosave.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    #[arg(long, default_value_t = 2, value_parser = |s: &str| crate::limits::SAMPLES_PER_PIXEL.parse(s))]
+    pub quit_after_passes: u32,
+    /// Replace a screenshot file that GI Studio did not write.
+    #[arg(long)]
+    pub force: bool,
+}
+
+fn parse_panes(text: &str) -> Result<usize, String> {
+    match text.trim() {
+        "1" => Ok(1),
+        "2" => Ok(2),
+        "4" => Ok(4),
+        other => Err(format!("must be 1, 2 or 4, found {other}")),
+    }
+}
 
 /// Open the studio and run until the window closes.
 pub fn run(args: StudioArgs) -> anyhow::Result<()> {
+    if let Some(path) = &args.screenshot {
+        capture::check_screenshot_path(path, args.force)?;
+    }
     let options = eframe::NativeOptions {
         viewport: eframe::egui::ViewportBuilder::default()
             .with_inner_size([1480.0, 920.0])
@@ -27,12 +64,23 @@ pub fn run(args: StudioArgs) -> anyhow::Result<()> {
             .with_drag_and_drop(true),
         ..Default::default()
     };
+    let (state, notice) = match storage::state_folder() {
+        Some(folder) => {
+            let (file, notice) = storage::StateFile::open(folder.join("app.ron"));
+            (Some(file), notice)
+        }
+        None => (None, None),
+    };
     let mut exit_error = None;
     eframe::run_native(
         "GI Studio",
         options,
         Box::new(|cc| {
-            let app = StudioApp::new(&cc.egui_ctx, cc.storage, &args);
+            let mut app = StudioApp::new(&cc.egui_ctx, state.as_ref().map(|s| s as &dyn eframe::Storage), &args);
+            app.notice(notice.unwrap_or_default());
+            if let Some(file) = state {
+                app.keep_state_in(file);
+            }
             exit_error = Some(app.exit_error.clone());
             Ok(Box::new(app))
         }),

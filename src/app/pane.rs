@@ -118,21 +118,23 @@ pub struct Pane {
     pub settings: RenderSettings,
     pub exposure: f32,
     pub state: PaneState,
-    session: RenderSession,
+    /// None when the OS refused the worker thread (said in `state.failed`).
+    session: Option<RenderSession>,
     texture: Option<egui::TextureHandle>,
 }
 
 impl Pane {
     pub fn new(ctx: &egui::Context, settings: RenderSettings) -> Self {
         let repaint = ctx.clone();
-        let session = RenderSession::new(Some(Arc::new(move || repaint.request_repaint())));
-        Self {
-            state: PaneState::new(0, settings.width, settings.height),
-            settings,
-            exposure: 0.0,
-            session,
-            texture: None,
-        }
+        let mut state = PaneState::new(0, settings.width, settings.height);
+        let session = match RenderSession::new(Some(Arc::new(move || repaint.request_repaint()))) {
+            Ok(session) => Some(session),
+            Err(e) => {
+                state.failed = Some(format!("could not start this pane's render worker: {e}"));
+                None
+            }
+        };
+        Self { state, settings, exposure: 0.0, session, texture: None }
     }
 
     pub fn algorithm(&self) -> Algorithm {
@@ -141,21 +143,32 @@ impl Pane {
 
     /// Abandon the current job and render `scene` afresh (never waits).
     pub fn restart(&mut self, scene: Arc<Scene>) {
-        let generation = self.session.start(RenderJob::new(scene, self.settings.clone()));
+        let Some(session) = &self.session else { return };
+        let generation = session.start(RenderJob::new(scene, self.settings.clone()));
         self.state = PaneState::new(generation, self.settings.width, self.settings.height);
     }
 
     pub fn pause(&mut self) {
-        self.session.cancel();
+        if let Some(session) = &self.session {
+            session.cancel();
+        }
     }
 
     /// Take every waiting event without blocking.
     pub fn poll(&mut self, reference: Option<&LinearImage>) -> bool {
+        let Some(session) = &self.session else { return false };
         let mut changed = false;
-        while let Ok(event) = self.session.events().try_recv() {
-            changed |= self.state.apply(event, reference);
+        loop {
+            match session.events().try_recv() {
+                Ok(event) => changed |= self.state.apply(event, reference),
+                Err(crossbeam_channel::TryRecvError::Empty) => return changed,
+                Err(crossbeam_channel::TryRecvError::Disconnected) => {
+                    self.state.failed = Some("this pane's render worker stopped".into());
+                    self.session = None;
+                    return true;
+                }
+            }
         }
-        changed
     }
 
     /// Bring the texture up to date: only the tiles that changed are

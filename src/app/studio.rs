@@ -10,6 +10,7 @@ use std::time::Instant;
 use eframe::egui;
 use serde::{Deserialize, Serialize};
 
+use super::capture::{save_screenshot, ScreenshotRequest};
 use super::export::{difference_rgba, export_image};
 use super::files::{file_dialog_ui, DialogPurpose, FileDialog};
 use super::history::History;
@@ -17,8 +18,10 @@ use super::inspector::{inspector_ui, Selection};
 use super::menu::menu_bar_ui;
 use super::pane::Pane;
 use super::plots::plots_ui;
+use super::storage::StateFile;
 use super::viewport::viewport_ui;
-use crate::cli::StudioArgs;
+use super::StudioArgs;
+use crate::limits;
 use crate::render::{Algorithm, LinearImage, RenderSettings};
 use crate::scene::{load_scene, presets, save_scene, to_ron, Invalid, Scene};
 
@@ -38,7 +41,50 @@ impl Default for Persisted {
     }
 }
 
+/// Saved state made safe to start from: a pane whose saved settings break
+/// a limit gets its defaults (`None`), and every fallback is said.
+pub struct Restored {
+    pub panes: Vec<Option<RenderSettings>>,
+    pub exposures: Vec<f32>,
+    pub show_plots: bool,
+    pub recent: Vec<PathBuf>,
+    pub notices: Vec<String>,
+}
+
+impl Persisted {
+    /// The saved state checked as a scene file is: whatever it holds, the
+    /// studio starts, and values out of their limits fall back to defaults.
+    pub fn restore(self) -> Restored {
+        let mut notices = Vec::new();
+        if self.panes.len() > 4 {
+            notices.push(format!("{} saved panes; the studio shows at most 4", self.panes.len()));
+        }
+        let panes = (self.panes.into_iter().take(4).enumerate())
+            .map(|(i, settings)| match settings.problems().first() {
+                None => Some(settings),
+                Some(problem) => {
+                    notices.push(format!("pane {}'s saved {problem}; its defaults are used", i + 1));
+                    None
+                }
+            })
+            .collect();
+        let exposures = (self.exposures.into_iter().take(4).enumerate())
+            .map(|(i, exposure)| {
+                limits::EXPOSURE_STOPS.check(exposure).unwrap_or_else(|problem| {
+                    notices.push(format!("pane {}'s saved exposure {problem}; 0 is used", i + 1));
+                    0.0
+                })
+            })
+            .collect();
+        let recent = self.recent.into_iter().take(RECENT_FILES).collect();
+        Restored { panes, exposures, show_plots: self.show_plots, recent, notices }
+    }
+}
+
+const RECENT_FILES: usize = 8;
+
 const STATE_KEY: &str = "studio";
+const STATE_SAVE_INTERVAL: std::time::Duration = std::time::Duration::from_secs(10);
 const AUTOSAVE_KEY: &str = "autosave_scene";
 
 /// Something that would discard unsaved edits: asked about first.
@@ -47,18 +93,6 @@ pub enum Action {
     NewFromPreset(String),
     Open(PathBuf),
     Quit,
-}
-
-struct ScreenshotRequest {
-    path: PathBuf,
-    crop: Option<egui::Rect>,
-    /// Wait until every pane has this many passes (the --screenshot mode).
-    after_passes: Option<u32>,
-    quit_after: bool,
-    /// Frames to wait first, so the dialog that asked for it is gone.
-    delay: u8,
-    requested: bool,
-    result: Arc<Mutex<Option<Result<(), String>>>>,
 }
 
 pub struct StudioApp {
@@ -81,9 +115,17 @@ pub struct StudioApp {
     /// Where each pane's image was drawn last frame (screen points).
     pub viewport_rects: Vec<egui::Rect>,
     dialog: Option<FileDialog>,
+    /// A chosen path that exists, waiting for the user to say replace it.
+    replace: Option<(DialogPurpose, PathBuf)>,
     pending: Option<Action>,
     quit_confirmed: bool,
+    /// The last session's unsaved scene, offered back; until answered, the
+    /// autosave that holds it is left alone.
     autosave_offer: Option<Scene>,
+    /// A `--screenshot` run: it saves no state and never touches the autosave.
+    capture_only: bool,
+    state_file: Option<StateFile>,
+    last_state_save: Instant,
     screenshot: Option<ScreenshotRequest>,
     difference: Option<egui::TextureHandle>,
     difference_at: Option<Instant>,
@@ -104,9 +146,14 @@ fn default_algorithms(count: usize) -> Vec<Algorithm> {
 }
 
 impl StudioApp {
-    /// Build the studio; `storage` restores layout, settings and recent files.
+    /// Build the studio; `storage` restores layout, settings and recent
+    /// files (checked: a bad saved value falls back with a notice).
     pub fn new(ctx: &egui::Context, storage: Option<&dyn eframe::Storage>, args: &StudioArgs) -> Self {
-        let persisted: Persisted = storage.and_then(|s| eframe::get_value(s, STATE_KEY)).unwrap_or_default();
+        let saved: Persisted = storage
+            .and_then(|s| s.get_string(STATE_KEY))
+            .and_then(|text| ron::from_str(&text).ok())
+            .unwrap_or_default();
+        let restored = saved.restore();
         let autosaved = storage.and_then(|s| s.get_string(AUTOSAVE_KEY)).filter(|t| !t.is_empty());
         let mut error = None;
         let (scene, scene_path) = match &args.scene {
@@ -119,10 +166,11 @@ impl StudioApp {
             },
             None => (presets::default_scene(), None),
         };
+        let capture_only = args.screenshot.is_some();
         let autosave_offer = autosaved
             .and_then(|text| crate::scene::parse_scene(&text, Path::new("autosave.ron")).ok())
-            .filter(|s| *s != scene && args.screenshot.is_none());
-        let count = args.panes.unwrap_or(persisted.panes.len().max(1)).clamp(1, 4);
+            .filter(|s| *s != scene && !capture_only);
+        let count = args.panes.unwrap_or(restored.panes.len().max(1)).clamp(1, 4);
         let count = if count == 3 { 4 } else { count };
         let mut app = Self {
             saved: scene.clone(),
@@ -134,17 +182,21 @@ impl StudioApp {
             selection: Selection::Camera,
             problems: Vec::new(),
             error,
-            status: String::new(),
-            show_plots: persisted.show_plots,
+            status: restored.notices.join("; "),
+            show_plots: restored.show_plots,
             show_difference: false,
             show_debug: false,
-            recent: persisted.recent.clone(),
+            recent: restored.recent,
             panes_rect: egui::Rect::NOTHING,
             viewport_rects: Vec::new(),
             dialog: None,
+            replace: None,
             pending: None,
             quit_confirmed: false,
             autosave_offer,
+            capture_only,
+            state_file: None,
+            last_state_save: Instant::now(),
             screenshot: None,
             difference: None,
             difference_at: None,
@@ -155,21 +207,44 @@ impl StudioApp {
             ctx: ctx.clone(),
             exit_error: Arc::new(Mutex::new(None)),
         };
-        let saved_panes = if args.panes.is_none() { persisted.panes } else { Vec::new() };
-        app.build_panes(count, &saved_panes, &persisted.exposures);
+        let saved_panes = if args.panes.is_none() { restored.panes } else { Vec::new() };
+        app.build_panes(count, &saved_panes, &restored.exposures);
         if let Some(path) = &args.screenshot {
             app.screenshot = Some(ScreenshotRequest {
-                path: path.clone(),
-                crop: None,
                 after_passes: Some(args.quit_after_passes.max(1)),
                 quit_after: true,
                 delay: 0,
-                requested: false,
-                result: Arc::new(Mutex::new(None)),
+                ..ScreenshotRequest::new(path.clone(), None)
             });
         }
         app.load_reference();
         app
+    }
+
+    /// Keep the state in `file`: written every few seconds and on exit.
+    pub fn keep_state_in(&mut self, file: StateFile) {
+        self.state_file = Some(file);
+    }
+
+    /// Write the state file (layout and autosave) if there is one.
+    fn save_state(&mut self) -> Result<(), String> {
+        self.last_state_save = Instant::now();
+        let Some(mut file) = self.state_file.take() else { return Ok(()) };
+        eframe::App::save(self, &mut file);
+        let written = if self.capture_only { Ok(()) } else { file.write() };
+        self.state_file = Some(file);
+        written.map_err(|e| format!("could not save the studio's state: {e}"))
+    }
+
+    /// Add a line to the status bar.
+    pub fn notice(&mut self, message: String) {
+        if message.is_empty() {
+            return;
+        }
+        if !self.status.is_empty() {
+            self.status += "; ";
+        }
+        self.status += &message;
     }
 
     fn pane_settings(&self, algorithm: Algorithm, count: usize) -> RenderSettings {
@@ -184,11 +259,12 @@ impl StudioApp {
         }
     }
 
-    fn build_panes(&mut self, count: usize, saved: &[RenderSettings], exposures: &[f32]) {
+    fn build_panes(&mut self, count: usize, saved: &[Option<RenderSettings>], exposures: &[f32]) {
         let algorithms = default_algorithms(count);
         self.panes = (0..count)
             .map(|i| {
-                let settings = saved.get(i).cloned().unwrap_or_else(|| self.pane_settings(algorithms[i], count));
+                let settings =
+                    saved.get(i).cloned().flatten().unwrap_or_else(|| self.pane_settings(algorithms[i], count));
                 let mut pane = Pane::new(&self.ctx, settings);
                 pane.exposure = exposures.get(i).copied().unwrap_or(self.scene.settings.exposure);
                 pane
@@ -279,12 +355,14 @@ impl StudioApp {
         let count = self.panes.len();
         let saved: Vec<RenderSettings> = self.panes.iter().map(|p| p.settings.clone()).collect();
         // The new scene's image size applies to every pane
-        let resized: Vec<RenderSettings> = saved
+        let resized: Vec<Option<RenderSettings>> = saved
             .into_iter()
-            .map(|s| RenderSettings {
-                width: self.pane_settings(s.algorithm, count).width,
-                height: self.pane_settings(s.algorithm, count).height,
-                ..s
+            .map(|s| {
+                Some(RenderSettings {
+                    width: self.pane_settings(s.algorithm, count).width,
+                    height: self.pane_settings(s.algorithm, count).height,
+                    ..s
+                })
             })
             .collect();
         let exposures: Vec<f32> = vec![self.scene.settings.exposure; count];
@@ -355,15 +433,7 @@ impl StudioApp {
     /// Save the window (or, for the comparison sheet, the panes' area with
     /// their labels) as PNG at the next frame.
     pub fn take_screenshot(&mut self, path: PathBuf, crop: Option<egui::Rect>) {
-        self.screenshot = Some(ScreenshotRequest {
-            path,
-            crop,
-            after_passes: None,
-            quit_after: false,
-            delay: 2,
-            requested: false,
-            result: Arc::new(Mutex::new(None)),
-        });
+        self.screenshot = Some(ScreenshotRequest::new(path, crop));
     }
 
     /// The preset's stored reference, used for the panes' error when their
@@ -484,6 +554,11 @@ impl StudioApp {
         self.history.observe(&self.scene, interacting);
         self.sync_engine();
         self.screenshot_step(&ctx);
+        if self.last_state_save.elapsed() >= STATE_SAVE_INTERVAL {
+            if let Err(e) = self.save_state() {
+                self.error = Some(e);
+            }
+        }
         if self.show_debug {
             egui::Area::new(egui::Id::unique("debug")).anchor(egui::Align2::RIGHT_TOP, egui::vec2(-8.0, 28.0)).show(
                 &ctx,
@@ -553,14 +628,28 @@ impl StudioApp {
                 self.dialog = None;
             }
             if let Some(path) = chosen {
-                match purpose {
-                    DialogPurpose::OpenScene => self.request(Action::Open(path)),
-                    DialogPurpose::SaveScene => self.save_to(&path),
-                    DialogPurpose::ExportPng | DialogPurpose::ExportExr => self.export_pane(0, &path),
-                    DialogPurpose::Screenshot => self.take_screenshot(path, None),
-                    DialogPurpose::ComparisonSheet => self.take_screenshot(path, Some(self.panes_rect)),
+                // Writing over another file is the user's call, asked once
+                let own_file = purpose == DialogPurpose::SaveScene && self.scene_path.as_deref() == Some(&path);
+                if purpose != DialogPurpose::OpenScene && path.exists() && !own_file {
+                    self.replace = Some((purpose, path));
+                } else {
+                    self.write_chosen(purpose, path);
                 }
             }
+        }
+        if let Some((purpose, path)) = self.replace.clone() {
+            egui::Window::new("Replace file?").collapsible(false).resizable(false).show(ctx, |ui| {
+                ui.label(format!("{} already exists. Replace it?", path.display()));
+                ui.horizontal(|ui| {
+                    if ui.button("Replace").clicked() {
+                        self.replace = None;
+                        self.write_chosen(purpose, path.clone());
+                    }
+                    if ui.button("Cancel").clicked() {
+                        self.replace = None;
+                    }
+                });
+            });
         }
         if let Some(action) = self.pending.clone() {
             egui::Window::new("Unsaved changes").collapsible(false).resizable(false).show(ctx, |ui| {
@@ -600,6 +689,18 @@ impl StudioApp {
         }
         if self.show_difference {
             self.difference_ui(ctx);
+        }
+    }
+
+    /// Act on a path the file dialog chose (and, if it existed, the user
+    /// agreed to replace).
+    pub fn write_chosen(&mut self, purpose: DialogPurpose, path: PathBuf) {
+        match purpose {
+            DialogPurpose::OpenScene => self.request(Action::Open(path)),
+            DialogPurpose::SaveScene => self.save_to(&path),
+            DialogPurpose::ExportPng | DialogPurpose::ExportExr => self.export_pane(0, &path),
+            DialogPurpose::Screenshot => self.take_screenshot(path, None),
+            DialogPurpose::ComparisonSheet => self.take_screenshot(path, Some(self.panes_rect)),
         }
     }
 
@@ -693,60 +794,41 @@ impl StudioApp {
     }
 }
 
-fn save_screenshot(
-    image: &egui::ColorImage,
-    crop: Option<egui::Rect>,
-    pixels_per_point: f32,
-    path: &Path,
-) -> Result<(), String> {
-    let [width, height] = image.size;
-    let (x0, y0, x1, y1) = match crop {
-        Some(rect) => {
-            let clamp = |v: f32, max: usize| ((v * pixels_per_point).round().max(0.0) as usize).min(max);
-            (clamp(rect.min.x, width), clamp(rect.min.y, height), clamp(rect.max.x, width), clamp(rect.max.y, height))
-        }
-        None => (0, 0, width, height),
-    };
-    if x1 <= x0 || y1 <= y0 {
-        return Err("nothing to capture".into());
-    }
-    let mut rgba = Vec::with_capacity((x1 - x0) * (y1 - y0) * 4);
-    for y in y0..y1 {
-        for x in x0..x1 {
-            rgba.extend_from_slice(&image.pixels[y * width + x].to_array());
-        }
-    }
-    image::save_buffer(path, &rgba, (x1 - x0) as u32, (y1 - y0) as u32, image::ExtendedColorType::Rgba8)
-        .map_err(|e| format!("{}: {e}", path.display()))
-}
-
 /// Per-pane render settings; returns whether the pane must restart.
 fn pane_settings_ui(ui: &mut egui::Ui, pane: &mut Pane) -> bool {
     let before = pane.settings.clone();
     let s = &mut pane.settings;
+    // The engine's limits, narrowed where a pane cannot use more
+    let range = |limit: limits::Limit<u32>| limit.min..=limit.max;
     let mut spp = s.samples_per_pixel.unwrap_or(0);
-    ui.add(egui::DragValue::new(&mut spp).range(0..=1_000_000).prefix("spp target (0: none) "));
+    ui.add(egui::DragValue::new(&mut spp).range(0..=limits::SAMPLES_PER_PIXEL.max).prefix("spp target (0: none) "));
     s.samples_per_pixel = (spp > 0).then_some(spp);
     let mut budget = s.time_limit.unwrap_or(0.0);
-    ui.add(egui::DragValue::new(&mut budget).range(0.0..=86_400.0).speed(0.5).prefix("time budget s (0: none) "));
+    ui.add(
+        egui::DragValue::new(&mut budget)
+            .range(0.0..=limits::SECONDS.max)
+            .speed(0.5)
+            .prefix("time budget s (0: none) "),
+    );
     s.time_limit = (budget > 0.0).then_some(budget);
-    ui.add(egui::DragValue::new(&mut s.max_depth).range(1..=256).prefix("max depth "));
+    ui.add(egui::DragValue::new(&mut s.max_depth).range(range(limits::MAX_DEPTH)).prefix("max depth "));
     ui.add(egui::DragValue::new(&mut s.width).range(16..=4096).prefix("width "));
     ui.add(egui::DragValue::new(&mut s.height).range(16..=4096).prefix("height "));
     if matches!(s.algorithm, Algorithm::Photon | Algorithm::Sppm) {
         ui.separator();
         let p = &mut s.photon;
-        ui.add(egui::DragValue::new(&mut p.global_photons).range(0..=50_000_000).speed(1000).prefix("global photons "));
+        let photons = range(limits::PHOTONS);
         ui.add(
-            egui::DragValue::new(&mut p.caustic_photons).range(0..=50_000_000).speed(1000).prefix("caustic photons "),
+            egui::DragValue::new(&mut p.global_photons).range(photons.clone()).speed(1000).prefix("global photons "),
         );
+        ui.add(egui::DragValue::new(&mut p.caustic_photons).range(photons).speed(1000).prefix("caustic photons "));
         ui.add(egui::DragValue::new(&mut p.k_nearest).range(8..=1000).prefix("k nearest "));
         ui.add(egui::DragValue::new(&mut p.max_radius).range(0.0..=1e6).speed(0.001).prefix("max radius (0: auto) "));
         ui.checkbox(&mut p.final_gather, "final gather");
         ui.add(egui::DragValue::new(&mut p.final_gather_rays).range(1..=1024).prefix("gather rays "));
         ui.add(
             egui::DragValue::new(&mut p.sppm_photons_per_pass)
-                .range(1..=50_000_000)
+                .range(range(limits::SPPM_PHOTONS))
                 .speed(1000)
                 .prefix("SPPM photons/pass "),
         );
@@ -770,42 +852,34 @@ impl eframe::App for StudioApp {
         self.show(ui);
     }
 
+    /// The layout and the autosave. A `--screenshot` run writes neither; while
+    /// the last session's scene is offered back, its autosave stays as it is
+    /// (a second crash must not lose it).
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        eframe::set_value(storage, STATE_KEY, &self.persisted());
-        // The scene being edited, offered back if the next start finds it unsaved
-        let autosave = if self.is_dirty() { to_ron(&self.scene).unwrap_or_default() } else { String::new() };
-        storage.set_string(AUTOSAVE_KEY, autosave);
+        if self.capture_only {
+            return;
+        }
+        match ron::to_string(&self.persisted()) {
+            Ok(text) => storage.set_string(STATE_KEY, text),
+            Err(e) => self.error = Some(format!("could not save the studio's layout: {e}")),
+        }
+        if self.autosave_offer.is_some() {
+            return;
+        }
+        if !self.is_dirty() {
+            storage.set_string(AUTOSAVE_KEY, String::new());
+            return;
+        }
+        match to_ron(&self.scene) {
+            Ok(text) => storage.set_string(AUTOSAVE_KEY, text),
+            Err(e) => self.error = Some(format!("could not autosave the scene: {e}")),
+        }
     }
 
-    fn auto_save_interval(&self) -> std::time::Duration {
-        std::time::Duration::from_secs(10)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn comparison_sheet_is_the_cropped_region_in_physical_pixels() {
-        let (w, h) = (20usize, 16usize);
-        let pixels: Vec<egui::Color32> =
-            (0..w * h).map(|i| egui::Color32::from_rgb((i % w) as u8, (i / w) as u8, 7)).collect();
-        let image = egui::ColorImage { size: [w, h], pixels, source_size: egui::vec2(w as f32, h as f32) };
-        let path = std::env::temp_dir().join(format!("gi-sheet-{}.png", std::process::id()));
-        // Points at 2 pixels per point: the rect (1, 2)–(5, 5) is pixels (2, 4)–(10, 10)
-        let rect = egui::Rect::from_min_max(egui::pos2(1.0, 2.0), egui::pos2(5.0, 5.0));
-        save_screenshot(&image, Some(rect), 2.0, &path).unwrap();
-        let saved = image::open(&path).unwrap().to_rgba8();
-        assert_eq!(saved.dimensions(), (8, 6));
-        assert_eq!(saved.get_pixel(0, 0).0, [2, 4, 7, 255]);
-        assert_eq!(saved.get_pixel(7, 5).0, [9, 9, 7, 255]);
-        assert!(save_screenshot(
-            &image,
-            Some(egui::Rect::from_min_max(egui::pos2(30.0, 30.0), egui::pos2(40.0, 40.0))),
-            1.0,
-            &path
-        )
-        .is_err());
+    fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {
+        // The window is gone: the terminal is the one place left to say it
+        if let Err(e) = self.save_state() {
+            eprintln!("error: {e}");
+        }
     }
 }

@@ -12,10 +12,13 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
+use super::outputs::Outputs;
 use super::reference::stem;
 use crate::analysis::convergence::{ConvergenceLog, ConvergencePoint};
 use crate::analysis::metrics::{flip, rel_mse, RelMseOptions};
 use crate::analysis::plot::plot_error_against_time;
+use crate::fileio::{self, SIGNATURE};
+use crate::limits;
 use crate::render::{Algorithm, LinearImage, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
 use crate::scene::{load_scene, Scene};
 
@@ -24,7 +27,7 @@ pub struct BenchArgs {
     /// Scene files; every preset with a reference in assets/references if none.
     pub scenes: Vec<PathBuf>,
     /// Seconds each algorithm renders each scene.
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, value_parser = |s: &str| limits::SECONDS.parse(s))]
     pub budget: f64,
     /// Comma-separated algorithms.
     #[arg(long, value_delimiter = ',', default_value = "whitted,path,photon,sppm")]
@@ -35,11 +38,17 @@ pub struct BenchArgs {
     /// Where the CSV, plots and final images go.
     #[arg(long, default_value = "bench-results")]
     pub out: PathBuf,
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = |s: &str| limits::THREADS.parse(s))]
     pub threads: usize,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Replace output files that GI Studio did not write.
+    #[arg(long)]
+    pub force: bool,
 }
+
+/// The CSV's first line, which also marks the file as this program's.
+const CSV_HEADER: &str = "scene,algorithm,seconds,spp,rays,relmse,flip\n";
 
 /// One algorithm on one scene.
 pub struct Run {
@@ -57,7 +66,7 @@ pub fn measure(
     reference: &LinearImage,
     progress: Option<&ProgressBar>,
 ) -> Result<Run> {
-    let session = RenderSession::new(None);
+    let session = RenderSession::new(None).context("could not start the render worker")?;
     let (width, height) = (settings.width, settings.height);
     let algorithm = settings.algorithm;
     let generation = session.start(RenderJob::new(Arc::new(scene.clone()), settings));
@@ -116,9 +125,6 @@ fn format_error(e: Option<f64>) -> String {
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
-    if args.budget.is_nan() || args.budget <= 0.0 {
-        bail!("--budget must be a positive number of seconds");
-    }
     let scenes: Vec<PathBuf> = if args.scenes.is_empty() {
         crate::scene::presets::names()
             .map(|n| PathBuf::from(format!("assets/scenes/{n}.ron")))
@@ -130,13 +136,28 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if scenes.is_empty() {
         bail!("no scenes with references in {}", args.references.display());
     }
-    std::fs::create_dir_all(&args.out).with_context(|| args.out.display().to_string())?;
-    let mut csv = String::from("scene,algorithm,seconds,spp,rays,relmse,flip\n");
+    // Every scene and reference read, every output claimed, before any work
+    let mut outputs = Outputs::new(args.force);
+    let mut work = Vec::new();
+    let sign: &[&[u8]] = &[SIGNATURE.as_bytes()];
     for scene_path in &scenes {
         let name = stem(scene_path);
         let scene = load_scene(scene_path)?;
         let reference_path = args.references.join(format!("{name}.exr"));
         let reference = LinearImage::load(&reference_path).with_context(|| format!("the reference for {name}"))?;
+        outputs.input(scene_path);
+        outputs.input(&reference_path);
+        for algorithm in &args.algos {
+            outputs.claim(&args.out.join(format!("{name}-{algorithm}.png")), sign)?;
+        }
+        outputs.claim(&args.out.join(format!("{name}.png")), sign)?;
+        work.push((name, scene, reference, reference_path));
+    }
+    let csv_path = args.out.join("convergence.csv");
+    outputs.claim(&csv_path, &[CSV_HEADER.as_bytes()])?;
+    std::fs::create_dir_all(&args.out).with_context(|| args.out.display().to_string())?;
+    let mut csv = String::from(CSV_HEADER);
+    for (name, scene, reference, reference_path) in work {
         println!(
             "\n{name} at {}×{} for {} s per algorithm (reference {})",
             reference.width,
@@ -183,8 +204,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             .map_err(anyhow::Error::msg)?;
         println!("plot → {}", plot_path.display());
     }
-    let csv_path = args.out.join("convergence.csv");
-    std::fs::write(&csv_path, csv).with_context(|| csv_path.display().to_string())?;
+    fileio::write_bytes(&csv_path, csv.as_bytes())?;
     println!("\nCSV → {}", csv_path.display());
     Ok(())
 }

@@ -1,45 +1,24 @@
-//! The headless side of the binary: `render` (and, as they land, `photons`,
-//! `reference`, `bench`). Errors become `anyhow` here, at the edge.
+//! The headless side of the binary: `render`, `photons`, `reference` and
+//! `bench`. Errors become `anyhow` here, at the edge. Every flag is checked
+//! against `crate::limits` as it is parsed.
 
 pub mod bench;
+pub mod outputs;
 pub mod photons;
 pub mod reference;
 pub mod render;
 
-use std::path::PathBuf;
-
 use clap::{Args, Parser, Subcommand};
 
+use crate::limits;
 use crate::render::Algorithm;
 
+/// The headless commands alone (the binary adds the studio's flags).
 #[derive(Debug, Parser)]
-#[command(
-    name = "gi-studio",
-    version,
-    about = "A studio for global illumination: Whitted ray tracing, path tracing, photon mapping and progressive photon mapping side by side."
-)]
-pub struct Cli {
+#[command(name = "gi-studio")]
+pub struct Headless {
     #[command(subcommand)]
-    pub command: Option<Command>,
-    #[command(flatten)]
-    pub studio: StudioArgs,
-}
-
-/// Options of the studio window (no subcommand).
-#[derive(Debug, Args, Default, Clone)]
-pub struct StudioArgs {
-    /// Open this scene file instead of the built-in Cornell box.
-    #[arg(long)]
-    pub scene: Option<PathBuf>,
-    /// Number of viewport panes (1, 2 or 4).
-    #[arg(long)]
-    pub panes: Option<usize>,
-    /// Save a screenshot of the window here once the panes have rendered
-    /// `--quit-after-passes` passes, then exit (for CI and the README).
-    #[arg(long)]
-    pub screenshot: Option<PathBuf>,
-    #[arg(long, default_value_t = 2)]
-    pub quit_after_passes: u32,
+    pub command: Command,
 }
 
 #[derive(Debug, Subcommand)]
@@ -61,29 +40,32 @@ pub struct RenderFlags {
     #[arg(long = "algo", default_value = "path")]
     pub algorithm: Algorithm,
     /// Samples per pixel (passes); the default is 64 unless --time is given.
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::SAMPLES_PER_PIXEL.parse(s))]
     pub spp: Option<u32>,
     /// Render for this many seconds of wall-clock time instead.
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::SECONDS.parse(s))]
     pub time: Option<f64>,
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::IMAGE_SIDE.parse(s))]
     pub width: Option<u32>,
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::IMAGE_SIDE.parse(s))]
     pub height: Option<u32>,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Worker threads (0: every core).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = |s: &str| limits::THREADS.parse(s))]
     pub threads: usize,
     /// Longest path (the algorithm's default if not given).
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::MAX_DEPTH.parse(s))]
     pub max_depth: Option<u32>,
     /// Exposure in stops for PNG output (the scene's if not given).
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::EXPOSURE_STOPS.parse(s))]
     pub exposure: Option<f32>,
     /// Limit every sample's channels to this value (off by default: it biases).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = |s: &str| limits::LENGTH.parse(s))]
     pub clamp: f32,
+    /// Replace output files that GI Studio did not write (never the inputs).
+    #[arg(long)]
+    pub force: bool,
     #[command(flatten)]
     pub photon: PhotonFlags,
 }
@@ -92,65 +74,47 @@ pub struct RenderFlags {
 #[derive(Debug, Args, Clone)]
 pub struct PhotonFlags {
     /// Photons emitted for the global map.
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::PHOTONS.parse(s))]
     pub global_photons: Option<u32>,
     /// Photons emitted toward specular objects for the caustic map.
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::PHOTONS.parse(s))]
     pub caustic_photons: Option<u32>,
-    /// Photons gathered per estimate (at least 8).
-    #[arg(long = "k")]
+    /// Photons gathered per estimate.
+    #[arg(long = "k", value_parser = |s: &str| limits::K_NEAREST.parse(s))]
     pub k_nearest: Option<u32>,
     /// Largest gather radius (scene units; 0 = from the scene's size).
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::LENGTH.parse(s))]
     pub max_radius: Option<f32>,
     /// Estimate indirect light by a final gather instead of reading the global map directly.
     #[arg(long)]
     pub final_gather: bool,
     /// Rays per final gather.
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::GATHER_RAYS.parse(s))]
     pub gather_rays: Option<u32>,
     /// SPPM: photons per pass.
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::SPPM_PHOTONS.parse(s))]
     pub sppm_photons: Option<u32>,
     /// SPPM: initial gather radius (0 = from the scene's size).
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::LENGTH.parse(s))]
     pub sppm_radius: Option<f32>,
     /// SPPM: radius reduction α in (0, 1].
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| limits::SPPM_ALPHA.parse(s))]
     pub sppm_alpha: Option<f32>,
 }
 
 impl PhotonFlags {
-    pub fn apply(&self, settings: &mut crate::render::PhotonSettings) -> anyhow::Result<()> {
+    /// The flags given, over `settings` (each was checked as it was parsed).
+    pub fn apply(&self, settings: &mut crate::render::PhotonSettings) {
         let p = settings;
-        if let Some(v) = self.global_photons {
-            p.global_photons = v;
-        }
-        if let Some(v) = self.caustic_photons {
-            p.caustic_photons = v;
-        }
-        if let Some(v) = self.k_nearest {
-            p.k_nearest = v.max(8);
-        }
-        if let Some(v) = self.max_radius {
-            anyhow::ensure!(v >= 0.0 && v.is_finite(), "--max-radius must be a finite number ≥ 0");
-            p.max_radius = v;
-        }
+        let set = |target: &mut u32, value: Option<u32>| *target = value.unwrap_or(*target);
+        set(&mut p.global_photons, self.global_photons);
+        set(&mut p.caustic_photons, self.caustic_photons);
+        set(&mut p.k_nearest, self.k_nearest);
+        set(&mut p.final_gather_rays, self.gather_rays);
+        set(&mut p.sppm_photons_per_pass, self.sppm_photons);
+        p.max_radius = self.max_radius.unwrap_or(p.max_radius);
+        p.sppm_initial_radius = self.sppm_radius.unwrap_or(p.sppm_initial_radius);
+        p.sppm_alpha = self.sppm_alpha.unwrap_or(p.sppm_alpha);
         p.final_gather |= self.final_gather;
-        if let Some(v) = self.gather_rays {
-            p.final_gather_rays = v.max(1);
-        }
-        if let Some(v) = self.sppm_photons {
-            p.sppm_photons_per_pass = v;
-        }
-        if let Some(v) = self.sppm_radius {
-            anyhow::ensure!(v >= 0.0 && v.is_finite(), "--sppm-radius must be a finite number ≥ 0");
-            p.sppm_initial_radius = v;
-        }
-        if let Some(v) = self.sppm_alpha {
-            anyhow::ensure!(v > 0.0 && v <= 1.0, "--sppm-alpha must be in (0, 1]");
-            p.sppm_alpha = v;
-        }
-        Ok(())
     }
 }

@@ -3,13 +3,14 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::ProgressBar;
 
+use super::outputs::Outputs;
 use super::render::map_line;
 use super::RenderFlags;
-use crate::photon::file::{save_photon_maps, settings_key};
+use crate::photon::file::{save_photon_maps, settings_key, MAGIC};
 use crate::photon::PhotonMaps;
 use crate::render::camera::CameraModel;
 use crate::render::world::World;
@@ -28,12 +29,18 @@ pub struct PhotonsArgs {
 
 pub fn run(args: &PhotonsArgs) -> Result<()> {
     let scene = load_scene(&args.scene)?;
+    let mut outputs = Outputs::new(args.flags.force);
+    outputs.input(&args.scene);
+    outputs.claim(&args.output, &[MAGIC])?;
     let settings = args.flags.settings(&scene)?;
     let bar = ProgressBar::new_spinner().with_message("tracing photons");
     bar.enable_steady_tick(Duration::from_millis(120));
     let camera = CameraModel::new(&scene.camera, settings.width, settings.height);
     let (world, visible_radius) = World::for_view(&scene, &camera, settings.width, settings.height);
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build()?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(settings.threads)
+        .build()
+        .with_context(|| format!("could not start {} threads", settings.threads))?;
     let maps =
         pool.install(|| PhotonMaps::build(&world, &settings.photon, settings.seed, settings.max_depth, visible_radius));
     bar.finish_and_clear();

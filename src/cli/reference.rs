@@ -4,12 +4,14 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 
+use super::outputs::Outputs;
 use super::render::render_with_progress;
 use super::RenderFlags;
-use crate::analysis::reference::{save_info, ReferenceInfo};
+use crate::analysis::reference::{info_path, save_info, ReferenceInfo};
+use crate::fileio::SIGNATURE;
 use crate::render::{Algorithm, RenderJob};
 use crate::scene::load_scene;
 
@@ -21,7 +23,7 @@ pub struct ReferenceArgs {
     /// Output EXR, for a single scene.
     #[arg(short, long, conflicts_with = "out_dir")]
     pub output: Option<PathBuf>,
-    /// Write DIR/<scene name>.exr (and .ron) for every scene.
+    /// Write DIR/<scene name>.exr (and .exr.meta.ron) for every scene.
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
     #[command(flatten)]
@@ -35,16 +37,24 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     let outputs: Vec<PathBuf> = match (&args.output, &args.out_dir) {
         (Some(output), None) if args.scenes.len() == 1 => vec![output.clone()],
         (None, Some(dir)) => {
-            std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+            std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
             args.scenes.iter().map(|s| dir.join(format!("{}.exr", stem(s)))).collect()
         }
         _ => bail!("give -o FILE.exr for one scene, or --out-dir DIR"),
     };
-    for (scene_path, output) in args.scenes.iter().zip(outputs) {
+    // Every scene read and every output claimed before the first render: a
+    // mistake in any of them writes nothing
+    let scenes = args.scenes.iter().map(|path| load_scene(path)).collect::<Result<Vec<_>, _>>()?;
+    let mut claims = Outputs::new(args.flags.force);
+    args.scenes.iter().for_each(|s| claims.input(s));
+    for output in &outputs {
         if output.extension().is_none_or(|e| e != "exr") {
             bail!("{}: references are linear EXR files", output.display());
         }
-        let scene = load_scene(scene_path)?;
+        claims.claim(output, &[SIGNATURE.as_bytes()])?;
+        claims.claim(&info_path(output), &[SIGNATURE.as_bytes()])?;
+    }
+    for ((scene_path, scene), output) in args.scenes.iter().zip(scenes).zip(outputs) {
         let mut settings = args.flags.settings(&scene)?;
         // Half the scene's size by default: the studio's four-pane size
         settings.width = args.flags.width.unwrap_or((scene.settings.width / 2).max(1));

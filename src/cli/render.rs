@@ -4,14 +4,17 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
+use super::outputs::Outputs;
 use super::RenderFlags;
+use crate::fileio::SIGNATURE;
 use crate::photon::file::{load_photon_maps, settings_key};
 use crate::photon::maps::MapStats;
 use crate::photon::PhotonMapStats;
+use crate::render::image::ImageFormat;
 use crate::render::{Algorithm, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
 use crate::scene::{load_scene, Scene};
 
@@ -54,19 +57,26 @@ impl RenderFlags {
         if let Some(depth) = self.max_depth {
             settings.max_depth = depth;
         }
-        anyhow::ensure!(self.clamp >= 0.0, "--clamp must not be negative");
         settings.firefly_clamp = self.clamp;
-        self.photon.apply(&mut settings.photon)?;
+        self.photon.apply(&mut settings.photon);
+        // Each flag was checked as it was parsed; what is left is the image
+        // size they make together with the scene's
+        if let Some(problem) = settings.problems().into_iter().next() {
+            bail!("{problem}");
+        }
         Ok(settings)
     }
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
     let scene = load_scene(&args.scene)?;
-    let extension = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    if !matches!(extension.as_deref(), Some("png" | "exr")) {
-        bail!("{}: the output must end in .png or .exr", args.output.display());
+    ImageFormat::of(&args.output)?;
+    let mut outputs = Outputs::new(args.flags.force);
+    outputs.input(&args.scene);
+    if let Some(path) = &args.photon_map {
+        outputs.input(path);
     }
+    outputs.claim(&args.output, &[SIGNATURE.as_bytes()])?;
     let settings = args.flags.settings(&scene)?;
     let exposure = args.flags.exposure.unwrap_or(scene.settings.exposure);
     let mut job = RenderJob::new(Arc::new(scene), settings.clone());
@@ -151,7 +161,7 @@ pub fn render_with_progress(job: RenderJob) -> Result<RenderOutcome> {
     );
     bar.enable_steady_tick(Duration::from_millis(200));
     let timed = settings.time_limit.is_some();
-    let session = RenderSession::new(None);
+    let session = RenderSession::new(None).context("could not start the render worker")?;
     let generation = session.start(job);
     let mut maps = None;
     let mut radii = Vec::new();

@@ -1,34 +1,44 @@
 //! Photon maps on disk, so the expensive pass can be reused: a small header
-//! (format version, the scene's content key, a key of the photon settings)
-//! and both trees in heap order, little-endian. A map for another scene,
-//! other settings or another format version is refused, saying which.
+//! (format version, the scene's content key, a key of the photon settings,
+//! the gather radius), both trees in heap order, little-endian, and a
+//! checksum of everything before it. A map for another scene, other
+//! settings or another format version is refused, saying which; so is a
+//! damaged one, before anything renders with it: the checksum catches bit
+//! flips, and each photon and the trees' order are checked as they are read.
 
-use std::io::{BufReader, BufWriter, Read, Write};
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use super::kdtree::PhotonKdTree;
 use super::maps::{MapStats, PhotonMapStats, PhotonMaps};
 use super::record::Photon;
+use crate::fileio::{self, FileError};
+use crate::limits;
 use crate::render::PhotonSettings;
 
-const MAGIC: &[u8; 8] = b"GIPHOTON";
+/// The file's first bytes; also what marks a photon map as this program's.
+pub const MAGIC: &[u8; 8] = b"GIPHOTON";
 /// 2: giant emitters emit only from the cap the camera can see.
-pub const FORMAT_VERSION: u32 = 2;
+/// 3: a checksum at the end.
+pub const FORMAT_VERSION: u32 = 3;
+const HEADER_BYTES: u64 = 8 + 4 + 8 + 8 + 4;
+const MAP_HEADER_BYTES: u64 = 16;
+const PHOTON_BYTES: u64 = 28;
 
 #[derive(Debug, thiserror::Error)]
 pub enum PhotonFileError {
-    #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    #[error(transparent)]
+    File(#[from] FileError),
     #[error("{path}: not a GI Studio photon map")]
     NotAPhotonMap { path: PathBuf },
-    #[error("{path}: photon map format version {found}, this program reads version {expected}")]
+    #[error("{path}: photon map format version {found}, this program reads version {expected} (trace the maps again with `gi-studio photons`)")]
     Version { path: PathBuf, found: u32, expected: u32 },
     #[error("{path}: this photon map was made for another scene (or an edited version of it)")]
     OtherScene { path: PathBuf },
     #[error("{path}: this photon map was made with other photon settings (photon counts, seed or path depth)")]
     OtherSettings { path: PathBuf },
-    #[error("{path}: the file is truncated or damaged")]
-    Damaged { path: PathBuf },
+    #[error("{path}: the file is truncated or damaged: {reason}")]
+    Damaged { path: PathBuf, reason: String },
 }
 
 /// What a map depends on besides the scene: the settings that change which
@@ -41,88 +51,235 @@ pub fn settings_key(settings: &PhotonSettings, seed: u64, max_depth: u32) -> u64
         .fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
 }
 
+/// A 64-bit checksum over a stream of bytes, eight at a time: each step
+/// (xor, odd multiply, rotate) is a bijection of the state, so changing any
+/// one word always changes the result.
+#[derive(Clone, Copy)]
+struct Checksum {
+    state: u64,
+    pending: [u8; 8],
+    filled: usize,
+}
+
+impl Checksum {
+    fn new() -> Self {
+        Self { state: 0x243f_6a88_85a3_08d3, pending: [0; 8], filled: 0 }
+    }
+
+    fn mix(&mut self, word: u64) {
+        self.state = (self.state ^ word).wrapping_mul(0x9e37_79b9_7f4a_7c15).rotate_left(29);
+    }
+
+    fn update(&mut self, mut bytes: &[u8]) {
+        while !bytes.is_empty() {
+            let take = (8 - self.filled).min(bytes.len());
+            self.pending[self.filled..self.filled + take].copy_from_slice(&bytes[..take]);
+            self.filled += take;
+            bytes = &bytes[take..];
+            if self.filled == 8 {
+                self.mix(u64::from_le_bytes(self.pending));
+                self.filled = 0;
+            }
+        }
+    }
+
+    fn finish(mut self) -> u64 {
+        let length = self.filled as u64;
+        self.pending[self.filled..].fill(0);
+        self.mix(u64::from_le_bytes(self.pending));
+        self.mix(length);
+        self.state
+    }
+}
+
+/// The checksum a map file ends with, of the bytes before it.
+pub fn checksum(bytes: &[u8]) -> u64 {
+    let mut sum = Checksum::new();
+    sum.update(bytes);
+    sum.finish()
+}
+
+/// Write both maps, atomically: a failed save leaves no partial file.
 pub fn save_photon_maps(
     maps: &PhotonMaps,
     scene_key: u64,
     settings_key: u64,
     path: &Path,
 ) -> Result<(), PhotonFileError> {
-    let io = |source| PhotonFileError::Io { path: path.to_owned(), source };
-    let mut out = BufWriter::new(std::fs::File::create(path).map_err(io)?);
-    let mut header = Vec::with_capacity(40);
-    header.extend_from_slice(MAGIC);
-    header.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-    header.extend_from_slice(&scene_key.to_le_bytes());
-    header.extend_from_slice(&settings_key.to_le_bytes());
-    header.extend_from_slice(&maps.max_radius.to_le_bytes());
-    out.write_all(&header).map_err(io)?;
-    for (tree, stats) in [(&maps.global, &maps.stats.global), (&maps.caustic, &maps.stats.caustic)] {
-        out.write_all(&stats.emitted.to_le_bytes()).map_err(io)?;
-        out.write_all(&(tree.len() as u64).to_le_bytes()).map_err(io)?;
-        for photon in tree.photons() {
-            out.write_all(&photon.to_bytes()).map_err(io)?;
+    Ok(fileio::write_atomic(path, |out| {
+        let mut sum = Checksum::new();
+        let mut put = |out: &mut dyn Write, bytes: &[u8]| {
+            sum.update(bytes);
+            out.write_all(bytes)
+        };
+        put(out, MAGIC)?;
+        put(out, &FORMAT_VERSION.to_le_bytes())?;
+        put(out, &scene_key.to_le_bytes())?;
+        put(out, &settings_key.to_le_bytes())?;
+        put(out, &maps.max_radius.to_le_bytes())?;
+        for (tree, stats) in [(&maps.global, &maps.stats.global), (&maps.caustic, &maps.stats.caustic)] {
+            put(out, &stats.emitted.to_le_bytes())?;
+            put(out, &(tree.len() as u64).to_le_bytes())?;
+            for photon in tree.photons() {
+                put(out, &photon.to_bytes())?;
+            }
         }
-    }
-    out.flush().map_err(io)
+        out.write_all(&sum.finish().to_le_bytes())
+    })?)
 }
 
-pub fn load_photon_maps(path: &Path, scene_key: u64, settings_key: u64) -> Result<PhotonMaps, PhotonFileError> {
-    let file = std::fs::File::open(path).map_err(|source| PhotonFileError::Io { path: path.to_owned(), source })?;
-    let mut input = BufReader::new(file);
-    let damaged = || PhotonFileError::Damaged { path: path.to_owned() };
-    let mut magic = [0u8; 8];
-    input.read_exact(&mut magic).map_err(|_| PhotonFileError::NotAPhotonMap { path: path.to_owned() })?;
-    if &magic != MAGIC {
-        return Err(PhotonFileError::NotAPhotonMap { path: path.to_owned() });
+/// A file's bytes read in order, summed, bounded by what the file holds.
+struct Reader<'a> {
+    input: std::io::BufReader<std::fs::File>,
+    left: u64,
+    sum: Checksum,
+    path: &'a Path,
+}
+
+impl Reader<'_> {
+    fn damaged(&self, reason: impl Into<String>) -> PhotonFileError {
+        PhotonFileError::Damaged { path: self.path.to_owned(), reason: reason.into() }
     }
-    let mut word = [0u8; 4];
-    input.read_exact(&mut word).map_err(|_| damaged())?;
-    let version = u32::from_le_bytes(word);
-    if version != FORMAT_VERSION {
-        return Err(PhotonFileError::Version { path: path.to_owned(), found: version, expected: FORMAT_VERSION });
-    }
-    let read_u64 = |input: &mut BufReader<std::fs::File>| -> Result<u64, PhotonFileError> {
-        let mut bytes = [0u8; 8];
-        input.read_exact(&mut bytes).map_err(|_| damaged())?;
-        Ok(u64::from_le_bytes(bytes))
-    };
-    if read_u64(&mut input)? != scene_key {
-        return Err(PhotonFileError::OtherScene { path: path.to_owned() });
-    }
-    if read_u64(&mut input)? != settings_key {
-        return Err(PhotonFileError::OtherSettings { path: path.to_owned() });
-    }
-    input.read_exact(&mut word).map_err(|_| damaged())?;
-    let max_radius = f32::from_le_bytes(word);
-    let read_tree = |input: &mut BufReader<std::fs::File>| -> Result<(PhotonKdTree, MapStats), PhotonFileError> {
-        let emitted = read_u64(input)?;
-        let count = read_u64(input)?;
-        // Refuse absurd counts before allocating for them
-        if count > 1 << 34 {
-            return Err(damaged());
+
+    fn bytes(&mut self, buffer: &mut [u8]) -> Result<(), PhotonFileError> {
+        if (buffer.len() as u64) > self.left {
+            return Err(self.damaged("it ends early"));
         }
-        let mut photons = Vec::with_capacity(count as usize);
-        let mut record = [0u8; 28];
-        for _ in 0..count {
-            input.read_exact(&mut record).map_err(|_| damaged())?;
-            photons.push(Photon::from_bytes(&record));
+        self.input.read_exact(buffer).map_err(|cause| FileError::Io { path: self.path.to_owned(), cause })?;
+        self.left -= buffer.len() as u64;
+        self.sum.update(buffer);
+        Ok(())
+    }
+
+    fn u64(&mut self) -> Result<u64, PhotonFileError> {
+        let mut word = [0; 8];
+        self.bytes(&mut word)?;
+        Ok(u64::from_le_bytes(word))
+    }
+
+    fn u32(&mut self) -> Result<u32, PhotonFileError> {
+        let mut word = [0; 4];
+        self.bytes(&mut word)?;
+        Ok(u32::from_le_bytes(word))
+    }
+
+    /// One map's counts and records: the count checked against what is
+    /// left of the file before anything is allocated for it.
+    fn map(&mut self, name: &str) -> Result<RawMap, PhotonFileError> {
+        let emitted = self.u64()?;
+        let count = self.u64()?;
+        if count > limits::STORED_PHOTONS || count * PHOTON_BYTES > self.left {
+            return Err(self.damaged(format!("the {name} map claims {count} photons, more than the file holds")));
         }
-        let tree = PhotonKdTree::from_heap_order(photons);
+        let mut records = vec![0u8; (count * PHOTON_BYTES) as usize];
+        self.bytes(&mut records)?;
+        Ok(RawMap { emitted, records })
+    }
+}
+
+/// A map as read, before its photons are checked (after the checksum).
+struct RawMap {
+    emitted: u64,
+    records: Vec<u8>,
+}
+
+impl RawMap {
+    /// Each photon, then the tree's order.
+    fn tree(
+        &self,
+        name: &str,
+        damaged: impl Fn(String) -> PhotonFileError,
+    ) -> Result<(PhotonKdTree, MapStats), PhotonFileError> {
+        let mut photons = Vec::with_capacity(self.records.len() / PHOTON_BYTES as usize);
+        for (i, record) in self.records.chunks_exact(PHOTON_BYTES as usize).enumerate() {
+            let record: &[u8; 28] = record.try_into().map_err(|_| damaged("a photon record is cut short".into()))?;
+            let photon = Photon::from_bytes(record)
+                .map_err(|what| damaged(format!("photon {i} of the {name} map has {what}")))?;
+            photons.push(photon);
+        }
+        let tree = PhotonKdTree::from_heap_order(photons)
+            .map_err(|i| damaged(format!("photon {i} of the {name} map is out of the tree's order")))?;
         let stats = MapStats {
-            emitted,
-            stored: count,
+            emitted: self.emitted,
+            stored: tree.len() as u64,
             bytes: tree.bytes() as u64,
             depth: tree.depth() as u32,
             ..MapStats::default()
         };
         Ok((tree, stats))
-    };
-    let (global, global_stats) = read_tree(&mut input)?;
-    let (caustic, caustic_stats) = read_tree(&mut input)?;
+    }
+}
+
+pub fn load_photon_maps(path: &Path, scene_key: u64, settings_key: u64) -> Result<PhotonMaps, PhotonFileError> {
+    let most = HEADER_BYTES + 2 * (MAP_HEADER_BYTES + limits::STORED_PHOTONS * PHOTON_BYTES) + 8;
+    let file = fileio::open_regular(path, most)?;
+    let left = file.metadata().map_err(|cause| FileError::Io { path: path.to_owned(), cause })?.len();
+    let mut input = Reader { input: std::io::BufReader::new(file), left, sum: Checksum::new(), path };
+    let not_ours = || PhotonFileError::NotAPhotonMap { path: path.to_owned() };
+    let mut magic = [0u8; 8];
+    input.bytes(&mut magic).map_err(|_| not_ours())?;
+    if &magic != MAGIC {
+        return Err(not_ours());
+    }
+    let version = input.u32()?;
+    if version != FORMAT_VERSION {
+        return Err(PhotonFileError::Version { path: path.to_owned(), found: version, expected: FORMAT_VERSION });
+    }
+    if input.u64()? != scene_key {
+        return Err(PhotonFileError::OtherScene { path: path.to_owned() });
+    }
+    if input.u64()? != settings_key {
+        return Err(PhotonFileError::OtherSettings { path: path.to_owned() });
+    }
+    let max_radius = f32::from_bits(input.u32()?);
+    let (global, caustic) = (input.map("global")?, input.map("caustic")?);
+    // The checksum first: a flipped bit is said as what it is, whatever it hit
+    let computed = input.sum.finish();
+    if input.left != 8 {
+        return Err(input.damaged(format!("{} bytes where the 8 of its checksum belong", input.left)));
+    }
+    if input.u64()? != computed {
+        return Err(input.damaged("its checksum does not match its contents"));
+    }
+    let damaged = |reason: String| PhotonFileError::Damaged { path: path.to_owned(), reason };
+    if !(max_radius.is_finite() && max_radius > 0.0) {
+        return Err(damaged(format!("its gather radius is {max_radius}")));
+    }
+    let (global, global_stats) = global.tree("global", damaged)?;
+    let (caustic, caustic_stats) = caustic.tree("caustic", damaged)?;
     Ok(PhotonMaps {
         global,
         caustic,
         stats: PhotonMapStats { global: global_stats, caustic: caustic_stats },
         max_radius,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_checksum_sees_every_single_byte_change_and_the_length() {
+        let data: Vec<u8> = (0..77u32).map(|i| (i * 37 % 251) as u8).collect();
+        let sum = |bytes: &[u8]| {
+            let mut c = Checksum::new();
+            // In uneven pieces: the result may not depend on how it is fed
+            for piece in bytes.chunks(5) {
+                c.update(piece);
+            }
+            c.finish()
+        };
+        let whole = sum(&data);
+        assert_eq!(checksum(&data), whole);
+        for i in 0..data.len() {
+            for bit in 0..8 {
+                let mut flipped = data.clone();
+                flipped[i] ^= 1 << bit;
+                assert_ne!(sum(&flipped), whole, "byte {i} bit {bit}");
+            }
+        }
+        assert_ne!(sum(&data[..76]), whole);
+        assert_ne!(sum(&[data.as_slice(), &[0]].concat()), whole);
+    }
 }

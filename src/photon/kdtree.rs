@@ -61,10 +61,34 @@ impl PhotonKdTree {
         Self { photons: tree, depth }
     }
 
-    /// A tree read back from a file, already in heap order.
-    pub fn from_heap_order(photons: Vec<Photon>) -> Self {
-        let depth = (usize::BITS - photons.len().leading_zeros()) as usize;
-        Self { photons, depth }
+    /// A tree read back from a file, already in heap order; refused (with
+    /// the first photon out of place) unless every split holds, since the
+    /// queries prune by them: each photon lies inside the box its ancestors'
+    /// splits leave it (left of a split ≤, right ≥, on that split's axis).
+    pub fn from_heap_order(photons: Vec<Photon>) -> Result<Self, usize> {
+        let n = photons.len();
+        // (node, lower and upper bounds from its ancestors): O(n) in all
+        let mut stack = Vec::with_capacity(128);
+        if n > 0 {
+            stack.push((0usize, Vec3::NEG_INFINITY, Vec3::INFINITY));
+        }
+        while let Some((node, lo, hi)) = stack.pop() {
+            let p = photons[node].position;
+            if !(p.cmpge(lo).all() && p.cmple(hi).all()) {
+                return Err(node);
+            }
+            let axis = photons[node].axis();
+            let (mut left_hi, mut right_lo) = (hi, lo);
+            left_hi[axis] = p[axis];
+            right_lo[axis] = p[axis];
+            for (child, lo, hi) in [(2 * node + 1, lo, left_hi), (2 * node + 2, right_lo, hi)] {
+                if child < n {
+                    stack.push((child, lo, hi));
+                }
+            }
+        }
+        let depth = (usize::BITS - n.leading_zeros()) as usize;
+        Ok(Self { photons, depth })
     }
 
     pub fn len(&self) -> usize {
@@ -304,6 +328,21 @@ mod tests {
                 assert_eq!(extent[axis], extent.max_element(), "node {i} of {n}");
             }
         }
+    }
+
+    #[test]
+    fn a_built_tree_reads_back_and_a_photon_out_of_place_is_found() {
+        let tree = PhotonKdTree::build(random_photons(500, 9));
+        let photons = tree.photons().to_vec();
+        assert_eq!(PhotonKdTree::from_heap_order(photons.clone()).unwrap().photons(), tree.photons());
+        // Node 3 is in node 0's left subtree: beyond node 0's split it breaks the order
+        let mut moved = photons.clone();
+        let axis = moved[0].axis();
+        moved[3].position[axis] = moved[0].position[axis] + 1.0;
+        assert_eq!(PhotonKdTree::from_heap_order(moved).unwrap_err(), 3);
+        let mut swapped = photons;
+        swapped.swap(1, 2);
+        assert!(PhotonKdTree::from_heap_order(swapped).is_err());
     }
 
     #[test]

@@ -91,16 +91,29 @@ impl Photon {
         out
     }
 
-    pub fn from_bytes(bytes: &[u8; 28]) -> Self {
+    /// A photon read back from a file, refused (saying what is wrong)
+    /// unless it is one `to_bytes` could have written: a finite position, a
+    /// finite power that is not negative, a split axis of 0, 1 or 2.
+    pub fn from_bytes(bytes: &[u8; 28]) -> Result<Self, &'static str> {
         let f = |i: usize| f32::from_le_bytes([bytes[i * 4], bytes[i * 4 + 1], bytes[i * 4 + 2], bytes[i * 4 + 3]]);
-        Self {
+        let photon = Self {
             position: Vec3::new(f(0), f(1), f(2)),
             power: [f(3), f(4), f(5)],
             theta: bytes[24],
             phi: bytes[25],
-            axis: bytes[26].min(2),
-            _pad: 0,
+            axis: bytes[26],
+            _pad: bytes[27],
+        };
+        if !photon.position.is_finite() {
+            return Err("a position that is not finite");
         }
+        if !photon.power.iter().all(|p| p.is_finite() && *p >= 0.0) {
+            return Err("a power that is negative or not finite");
+        }
+        if photon.axis > 2 || photon._pad != 0 {
+            return Err("a split axis other than x, y or z");
+        }
+        Ok(photon)
     }
 }
 
@@ -109,6 +122,22 @@ mod tests {
     use super::*;
     use crate::render::rng::Sampler;
     use crate::render::sampling::uniform_sphere;
+
+    #[test]
+    fn damaged_records_are_refused() {
+        let good = Photon::new(Vec3::new(1.0, 2.0, 3.0), Vec3::Z, [0.5; 3]).to_bytes();
+        let with = |at: usize, bytes: &[u8]| {
+            let mut b = good;
+            b[at..at + bytes.len()].copy_from_slice(bytes);
+            Photon::from_bytes(&b)
+        };
+        assert!(with(4, &f32::NAN.to_le_bytes()).unwrap_err().contains("position"));
+        assert!(with(16, &(-1.0f32).to_le_bytes()).unwrap_err().contains("power"));
+        assert!(with(20, &f32::INFINITY.to_le_bytes()).unwrap_err().contains("power"));
+        assert!(with(26, &[3]).unwrap_err().contains("axis"));
+        assert!(with(27, &[1]).is_err());
+        assert!(with(26, &[2]).is_ok());
+    }
 
     #[test]
     fn photon_is_28_bytes() {
@@ -124,7 +153,7 @@ mod tests {
         for d in axes.into_iter().chain((0..10_000).map(|_| uniform_sphere(s.next_2d()))) {
             let p = Photon::new(Vec3::ZERO, d, [1.0; 3]);
             assert!(p.incoming_direction().dot(d) > tolerance, "{d} → {}", p.incoming_direction());
-            assert_eq!(Photon::from_bytes(&p.to_bytes()), p);
+            assert_eq!(Photon::from_bytes(&p.to_bytes()), Ok(p));
         }
     }
 }

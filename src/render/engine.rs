@@ -153,23 +153,17 @@ pub struct RenderSession {
     worker: Option<JoinHandle<()>>,
 }
 
-impl Default for RenderSession {
-    fn default() -> Self {
-        Self::new(None)
-    }
-}
-
 impl RenderSession {
-    pub fn new(notify: Option<Notify>) -> Self {
+    /// Start the session's worker thread (the OS may refuse one).
+    pub fn new(notify: Option<Notify>) -> std::io::Result<Self> {
         let (commands, command_rx) = crossbeam_channel::unbounded();
         let (event_tx, events) = crossbeam_channel::unbounded();
         let generation = Arc::new(AtomicU64::new(0));
         let worker_generation = generation.clone();
         let worker = std::thread::Builder::new()
             .name("render-worker".into())
-            .spawn(move || worker_loop(command_rx, event_tx, worker_generation, notify))
-            .ok();
-        Self { commands, events, generation, worker }
+            .spawn(move || worker_loop(command_rx, event_tx, worker_generation, notify))?;
+        Ok(Self { commands, events, generation, worker: Some(worker) })
     }
 
     /// Start rendering `job`, abandoning whatever was in flight. Returns the
@@ -227,7 +221,8 @@ fn worker_loop(
             match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
                 Ok(pool) => pools = Some((threads, pool)),
                 Err(e) => {
-                    let _ = events.send(RenderEvent::Failed { generation: job_generation, message: e.to_string() });
+                    let message = format!("could not start {threads} render threads: {e}");
+                    let _ = events.send(RenderEvent::Failed { generation: job_generation, message });
                     continue;
                 }
             }
@@ -290,8 +285,8 @@ fn run_job(context: &JobContext, job: &RenderJob) {
         context.send(RenderEvent::Failed { generation, message: problem.to_string() });
         return;
     }
-    if settings.width == 0 || settings.height == 0 {
-        context.send(RenderEvent::Failed { generation, message: "image size must be at least 1×1".into() });
+    if let Some(problem) = settings.problems().into_iter().next() {
+        context.send(RenderEvent::Failed { generation, message: problem.to_string() });
         return;
     }
     let camera = CameraModel::new(&job.scene.camera, settings.width, settings.height);
@@ -611,7 +606,7 @@ impl FrameContext<'_> {
 /// Render a job to completion on its own session, for tests and tools that
 /// want just the image (and the final statistics).
 pub fn render_blocking(job: &RenderJob) -> Result<(LinearImage, PassStats), String> {
-    let session = RenderSession::new(None);
+    let session = RenderSession::new(None).map_err(|e| format!("could not start the render worker: {e}"))?;
     let generation = session.start(RenderJob { stream_tiles: false, ..job.clone() });
     for event in session.events().iter() {
         match event {

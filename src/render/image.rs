@@ -2,6 +2,9 @@
 
 use std::path::Path;
 
+use crate::fileio::{self, FileError, SIGNATURE};
+use crate::limits;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct LinearImage {
     pub width: u32,
@@ -14,10 +17,53 @@ pub struct LinearImage {
 pub enum ImageError {
     #[error("{path}: unsupported image extension (use .png or .exr)")]
     UnknownFormat { path: String },
-    #[error("{path}: {source}")]
-    Write { path: String, source: image::ImageError },
-    #[error("{path}: {source}")]
-    Read { path: String, source: image::ImageError },
+    #[error("{path}: could not encode the image: {reason}")]
+    Encode { path: String, reason: String },
+    #[error("{path}: {reason}")]
+    Decode { path: String, reason: String },
+    #[error(transparent)]
+    File(#[from] FileError),
+}
+
+/// The two formats images are saved in, by their file's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// Tone-mapped sRGB, 8 bits.
+    Png,
+    /// Linear 32-bit float.
+    Exr,
+}
+
+impl ImageFormat {
+    pub fn of(path: &Path) -> Result<Self, ImageError> {
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("png") => Ok(Self::Png),
+            Some("exr") => Ok(Self::Exr),
+            _ => Err(ImageError::UnknownFormat { path: path.display().to_string() }),
+        }
+    }
+}
+
+/// An 8-bit PNG (RGB, or RGBA when `alpha`) carrying the program's signature
+/// in a `Software` text chunk, so it is known as ours (`fileio::replaceable`).
+pub fn png_bytes(width: u32, height: u32, alpha: bool, data: &[u8]) -> Result<Vec<u8>, String> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_color(if alpha { png::ColorType::Rgba } else { png::ColorType::Rgb });
+    encoder.set_depth(png::BitDepth::Eight);
+    let software = format!("{SIGNATURE} {}", env!("CARGO_PKG_VERSION"));
+    encoder.add_text_chunk("Software".into(), software).map_err(|e| e.to_string())?;
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    writer.write_image_data(data).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+/// Write a PNG atomically (see `png_bytes`).
+pub fn save_png(path: &Path, width: u32, height: u32, alpha: bool, data: &[u8]) -> Result<(), ImageError> {
+    let bytes = png_bytes(width, height, alpha, data)
+        .map_err(|reason| ImageError::Encode { path: path.display().to_string(), reason })?;
+    Ok(fileio::write_bytes(path, &bytes)?)
 }
 
 /// sRGB opto-electronic transfer function on [0, 1].
@@ -109,32 +155,60 @@ impl LinearImage {
             .then(|| std::borrow::Cow::Owned(self.downsample(factor)))
     }
 
-    /// `.png`: tone-mapped sRGB 8-bit; `.exr`: linear 32-bit float.
+    /// `.png`: tone-mapped sRGB 8-bit; `.exr`: linear 32-bit float. Written
+    /// atomically: a failed save leaves whatever was at `path` as it was.
     pub fn save(&self, path: &Path, exposure_stops: f32) -> Result<(), ImageError> {
-        let name = path.display().to_string();
-        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-        let result = match extension.as_deref() {
-            Some("png") => {
-                let rgb: Vec<u8> = self.pixels.iter().flat_map(|p| tonemap_srgb8(*p, exposure_stops)).collect();
-                image::save_buffer(path, &rgb, self.width, self.height, image::ExtendedColorType::Rgb8)
-            }
-            Some("exr") => {
-                let data: Vec<f32> = self.pixels.iter().flatten().copied().collect();
-                match image::Rgb32FImage::from_raw(self.width, self.height, data) {
-                    Some(buffer) => buffer.save(path),
-                    None => dimension_mismatch(),
-                }
-            }
-            _ => return Err(ImageError::UnknownFormat { path: name }),
-        };
-        result.map_err(|source| ImageError::Write { path: name, source })
+        let bytes = self
+            .encode(ImageFormat::of(path)?, exposure_stops)
+            .map_err(|reason| ImageError::Encode { path: path.display().to_string(), reason })?;
+        Ok(fileio::write_bytes(path, &bytes)?)
     }
 
-    /// Load a linear EXR (references) or an 8-bit image decoded from sRGB.
+    /// The file's bytes in `format`.
+    pub fn encode(&self, format: ImageFormat, exposure_stops: f32) -> Result<Vec<u8>, String> {
+        if self.pixels.len() != self.width as usize * self.height as usize {
+            return Err(format!("{} pixels for a {}×{} image", self.pixels.len(), self.width, self.height));
+        }
+        match format {
+            ImageFormat::Png => {
+                let rgb: Vec<u8> = self.pixels.iter().flat_map(|p| tonemap_srgb8(*p, exposure_stops)).collect();
+                png_bytes(self.width, self.height, false, &rgb)
+            }
+            ImageFormat::Exr => {
+                use exr::prelude::{Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage};
+                let width = self.width as usize;
+                let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+                    let [r, g, b] = self.pixels[y * width + x];
+                    (r, g, b)
+                });
+                let mut attributes = LayerAttributes::named("");
+                attributes.software_name = Some(SIGNATURE.into());
+                let layer = Layer::new((width, self.height as usize), attributes, Encoding::FAST_LOSSLESS, channels);
+                let mut bytes = std::io::Cursor::new(Vec::new());
+                Image::from_layer(layer).write().to_buffered(&mut bytes).map_err(|e| e.to_string())?;
+                Ok(bytes.into_inner())
+            }
+        }
+    }
+
+    /// Load a linear EXR (references) or an 8-bit image decoded from sRGB;
+    /// only a regular file, and no larger than the largest image the
+    /// program renders (`limits::IMAGE_PIXELS`).
     pub fn load(path: &Path) -> Result<Self, ImageError> {
         let name = path.display().to_string();
-        let decoded = image::open(path).map_err(|source| ImageError::Read { path: name, source })?;
-        let is_exr = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        let decode = |reason: String| ImageError::Decode { path: name.clone(), reason };
+        let most_bytes = limits::IMAGE_PIXELS * 16 + (1 << 20);
+        let file = fileio::open_regular(path, most_bytes)?;
+        let mut reader = image::ImageReader::new(std::io::BufReader::new(file))
+            .with_guessed_format()
+            .map_err(|e| decode(e.to_string()))?;
+        let mut bounds = image::Limits::default();
+        bounds.max_image_width = Some(limits::IMAGE_SIDE.max);
+        bounds.max_image_height = Some(limits::IMAGE_SIDE.max);
+        bounds.max_alloc = Some(most_bytes);
+        reader.limits(bounds);
+        let decoded = reader.decode().map_err(|e| decode(e.to_string()))?;
+        let is_exr = ImageFormat::of(path).is_ok_and(|f| f == ImageFormat::Exr);
         let rgb = decoded.to_rgb32f();
         let (width, height) = rgb.dimensions();
         let pixels = rgb.pixels().map(|p| if is_exr { p.0 } else { p.0.map(srgb_decode) }).collect();
@@ -148,14 +222,6 @@ fn srgb_decode(v: f32) -> f32 {
     } else {
         ((v + 0.055) / 1.055).powf(2.4)
     }
-}
-
-/// The fields are public: an image whose pixel count disagrees with its size
-/// is refused as the PNG path refuses it.
-fn dimension_mismatch() -> image::ImageResult<()> {
-    Err(image::ImageError::Parameter(image::error::ParameterError::from_kind(
-        image::error::ParameterErrorKind::DimensionMismatch,
-    )))
 }
 
 #[cfg(test)]
@@ -192,5 +258,21 @@ mod tests {
         let png = LinearImage::load(&dir.join("a.png")).unwrap();
         assert_eq!((png.width, png.height), (3, 2));
         assert!(matches!(img.save(&dir.join("a.bmpx"), 0.0), Err(ImageError::UnknownFormat { .. })));
+    }
+
+    #[test]
+    fn saved_images_carry_the_signature_and_refuse_a_wrong_size() {
+        let dir = std::env::temp_dir().join(format!("gi-image-sign-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let img = LinearImage::new(5, 4);
+        for name in ["s.png", "s.exr"] {
+            img.save(&dir.join(name), 0.0).unwrap();
+            assert!(fileio::replaceable(&dir.join(name), &[SIGNATURE.as_bytes()]).unwrap(), "{name}");
+        }
+        let broken = LinearImage { width: 5, height: 5, ..img };
+        for name in ["b.png", "b.exr"] {
+            assert!(matches!(broken.save(&dir.join(name), 0.0), Err(ImageError::Encode { .. })), "{name}");
+            assert!(!dir.join(name).exists(), "{name}");
+        }
     }
 }

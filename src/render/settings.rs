@@ -5,6 +5,8 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
+use crate::limits::{self, OutOfRange};
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Algorithm {
     Whitted,
@@ -141,5 +143,69 @@ impl Default for RenderSettings {
 impl RenderSettings {
     pub fn for_algorithm(algorithm: Algorithm) -> Self {
         Self { algorithm, max_depth: algorithm.default_max_depth(), ..Self::default() }
+    }
+}
+
+/// A setting outside its limit: which one, and what is wrong.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{field}: {problem}")]
+pub struct SettingProblem {
+    pub field: &'static str,
+    pub problem: OutOfRange,
+}
+
+impl RenderSettings {
+    /// Every setting against `crate::limits`: what the engine refuses to
+    /// start, the CLI to accept and the studio to restore.
+    pub fn problems(&self) -> Vec<SettingProblem> {
+        let mut found = Vec::new();
+        let mut check = |field: &'static str, result: Result<(), OutOfRange>| {
+            if let Err(problem) = result {
+                found.push(SettingProblem { field, problem });
+            }
+        };
+        check("size", limits::check_image_size(self.width, self.height));
+        check("samples_per_pixel", self.samples_per_pixel.map_or(Ok(()), |n| ok(limits::SAMPLES_PER_PIXEL.check(n))));
+        check("time_limit", self.time_limit.map_or(Ok(()), |t| ok(limits::SECONDS.check(t))));
+        check("threads", ok(limits::THREADS.check(self.threads)));
+        check("max_depth", ok(limits::MAX_DEPTH.check(self.max_depth)));
+        check("firefly_clamp", ok(limits::LENGTH.check(self.firefly_clamp)));
+        check("tile_size", ok(limits::TILE_SIZE.check(self.tile_size)));
+        let p = &self.photon;
+        check("global_photons", ok(limits::PHOTONS.check(p.global_photons)));
+        check("caustic_photons", ok(limits::PHOTONS.check(p.caustic_photons)));
+        check("k_nearest", ok(limits::K_NEAREST.check(p.k_nearest)));
+        check("max_radius", ok(limits::LENGTH.check(p.max_radius)));
+        check("final_gather_rays", ok(limits::GATHER_RAYS.check(p.final_gather_rays)));
+        check("sppm_photons_per_pass", ok(limits::SPPM_PHOTONS.check(p.sppm_photons_per_pass)));
+        check("sppm_initial_radius", ok(limits::LENGTH.check(p.sppm_initial_radius)));
+        check("sppm_alpha", ok(limits::SPPM_ALPHA.check(p.sppm_alpha)));
+        found
+    }
+}
+
+fn ok<T>(result: Result<T, OutOfRange>) -> Result<(), OutOfRange> {
+    result.map(|_| ())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_within_limits_and_each_bad_value_is_named() {
+        for algorithm in Algorithm::ALL {
+            assert_eq!(RenderSettings::for_algorithm(algorithm).problems(), vec![], "{algorithm}");
+        }
+        let bad = RenderSettings {
+            width: 100_000,
+            threads: 100_000,
+            tile_size: 0,
+            time_limit: Some(f64::NAN),
+            photon: PhotonSettings { k_nearest: u32::MAX, ..PhotonSettings::default() },
+            ..RenderSettings::default()
+        };
+        let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
+        assert_eq!(fields, ["size", "time_limit", "threads", "tile_size", "k_nearest"]);
     }
 }

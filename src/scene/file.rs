@@ -4,11 +4,14 @@
 use std::path::{Path, PathBuf};
 
 use super::{Invalid, Scene};
+use crate::fileio::{self, FileError};
+use crate::limits;
 
 #[derive(Debug, thiserror::Error)]
 pub enum SceneFileError {
-    #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    /// Not read or not written: the path and the OS's reason.
+    #[error(transparent)]
+    File(#[from] FileError),
     /// The text is not a well-formed scene (bad syntax, unknown or missing field).
     #[error("{path}:{line}:{column}: {message}")]
     Syntax { path: PathBuf, line: usize, column: usize, message: String },
@@ -26,9 +29,10 @@ fn more_note(others: usize) -> String {
     }
 }
 
-/// Read and validate a scene file.
+/// Read and validate a scene file: a regular file of at most
+/// `limits::TEXT_FILE_BYTES`, UTF-8.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneFileError::Io { path: path.to_owned(), source })?;
+    let text = fileio::read_text(path, limits::TEXT_FILE_BYTES)?;
     parse_scene(&text, path)
 }
 
@@ -55,14 +59,10 @@ pub fn to_ron(scene: &Scene) -> Result<String, SceneFileError> {
     ron::ser::to_string_pretty(scene, config).map_err(|e| SceneFileError::Serialize(e.to_string()))
 }
 
-/// Write the scene; written to a temporary file first so a failed save never
-/// leaves half a scene behind.
+/// Write the scene atomically: a failed save leaves the old file whole.
 pub fn save_scene(scene: &Scene, path: &Path) -> Result<(), SceneFileError> {
-    let text = to_ron(scene)?;
-    let io = |source| SceneFileError::Io { path: path.to_owned(), source };
-    let partial = path.with_extension("ron.partial");
-    std::fs::write(&partial, text + "\n").map_err(io)?;
-    std::fs::rename(&partial, path).map_err(io)
+    let text = to_ron(scene)? + "\n";
+    Ok(fileio::write_bytes(path, text.as_bytes())?)
 }
 
 /// Where an invalid value sits in the text: the section, then the item's

@@ -82,6 +82,7 @@ pub struct Material {
 /// models: Whitted uses them as written, the Monte Carlo algorithms as
 /// energy-conserving (normalised) BRDFs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum MaterialModel {
     Lambert {
         albedo: Rgb,
@@ -135,6 +136,7 @@ pub struct Object {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Shape {
     Sphere {
         center: Vec3,
@@ -174,6 +176,7 @@ fn enabled_by_default() -> bool {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum LightKind {
     Point {
         position: Vec3,

@@ -6,6 +6,7 @@ use std::collections::HashSet;
 use glam::Vec3;
 
 use super::{LightKind, MaterialModel, Scene, Shape};
+use crate::limits;
 
 /// One invalid value: where it is (a readable path plus what the file locator
 /// needs) and what is wrong with it.
@@ -47,6 +48,8 @@ pub enum Problem {
     DuplicateName(String),
     #[error("must not be empty")]
     EmptyName,
+    #[error("{width} × {height} is more than the {} pixels an image may have", limits::IMAGE_PIXELS)]
+    TooManyPixels { width: u32, height: u32 },
 }
 
 struct Checker<'a> {
@@ -160,12 +163,21 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
     check.non_negative("focus_distance", camera.focus_distance);
 
     check.at("settings", None, None, "");
+    let side = limits::IMAGE_SIDE;
     for (key, v) in [("width", scene.settings.width), ("height", scene.settings.height)] {
-        if !(1..=16384).contains(&v) {
-            check.report(key, Problem::OutOfRange { min: 1.0, max: 16384.0, found: v as f32 });
+        if !side.contains(v) {
+            check.report(key, Problem::OutOfRange { min: side.min as f32, max: side.max as f32, found: v as f32 });
         }
     }
-    check.finite("exposure", scene.settings.exposure);
+    let (width, height) = (scene.settings.width, scene.settings.height);
+    if side.contains(width) && side.contains(height) && width as u64 * height as u64 > limits::IMAGE_PIXELS {
+        check.report("height", Problem::TooManyPixels { width, height });
+    }
+    let exposure = scene.settings.exposure;
+    let stops = limits::EXPOSURE_STOPS;
+    if check.finite("exposure", exposure) && !stops.contains(exposure) {
+        check.report("exposure", Problem::OutOfRange { min: stops.min, max: stops.max, found: exposure });
+    }
     check.at("scene", None, None, "");
     check.colour("background", scene.background);
     check.colour("ambient", scene.ambient);

@@ -1,0 +1,122 @@
+//! Screenshots of the window and the comparison sheet (the panes' area with
+//! their labels): asked of egui at a frame, saved when the image arrives.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use anyhow::{bail, Result};
+use eframe::egui;
+
+use crate::fileio::{self, SIGNATURE};
+use crate::render::image::{save_png, ImageFormat};
+
+/// A screenshot on its way: where, which part, and when.
+pub struct ScreenshotRequest {
+    pub path: PathBuf,
+    pub crop: Option<egui::Rect>,
+    /// Wait until every pane has this many passes (the --screenshot mode).
+    pub after_passes: Option<u32>,
+    pub quit_after: bool,
+    /// Frames to wait first, so the dialog that asked for it is gone.
+    pub delay: u8,
+    pub requested: bool,
+    pub result: Arc<Mutex<Option<Result<(), String>>>>,
+}
+
+impl ScreenshotRequest {
+    pub fn new(path: PathBuf, crop: Option<egui::Rect>) -> Self {
+        Self {
+            path,
+            crop,
+            after_passes: None,
+            quit_after: false,
+            delay: 2,
+            requested: false,
+            result: Arc::new(Mutex::new(None)),
+        }
+    }
+}
+
+/// `--screenshot PATH` checked before the window opens: a PNG, in a folder
+/// that exists, not replacing a file GI Studio did not write (unless forced).
+pub fn check_screenshot_path(path: &Path, force: bool) -> Result<()> {
+    if !matches!(ImageFormat::of(path), Ok(ImageFormat::Png)) {
+        bail!("{}: screenshots are PNG files (end the name in .png)", path.display());
+    }
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !folder.is_dir() {
+        bail!("{}: the folder {} does not exist", path.display(), folder.display());
+    }
+    if !force && !fileio::replaceable(path, &[SIGNATURE.as_bytes()])? {
+        bail!("{}: exists and was not written by GI Studio; pass --force to replace it", path.display());
+    }
+    Ok(())
+}
+
+/// Save `image` (or its `crop`, in points) as a PNG, atomically.
+pub fn save_screenshot(
+    image: &egui::ColorImage,
+    crop: Option<egui::Rect>,
+    pixels_per_point: f32,
+    path: &Path,
+) -> Result<(), String> {
+    let [width, height] = image.size;
+    let (x0, y0, x1, y1) = match crop {
+        Some(rect) => {
+            let clamp = |v: f32, max: usize| ((v * pixels_per_point).round().max(0.0) as usize).min(max);
+            (clamp(rect.min.x, width), clamp(rect.min.y, height), clamp(rect.max.x, width), clamp(rect.max.y, height))
+        }
+        None => (0, 0, width, height),
+    };
+    if x1 <= x0 || y1 <= y0 {
+        return Err("nothing to capture".into());
+    }
+    let mut rgba = Vec::with_capacity((x1 - x0) * (y1 - y0) * 4);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            rgba.extend_from_slice(&image.pixels[y * width + x].to_array());
+        }
+    }
+    save_png(path, (x1 - x0) as u32, (y1 - y0) as u32, true, &rgba).map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn comparison_sheet_is_the_cropped_region_in_physical_pixels() {
+        let (w, h) = (20usize, 16usize);
+        let pixels: Vec<egui::Color32> =
+            (0..w * h).map(|i| egui::Color32::from_rgb((i % w) as u8, (i / w) as u8, 7)).collect();
+        let image = egui::ColorImage { size: [w, h], pixels, source_size: egui::vec2(w as f32, h as f32) };
+        let path = std::env::temp_dir().join(format!("gi-sheet-{}.png", std::process::id()));
+        // Points at 2 pixels per point: the rect (1, 2)–(5, 5) is pixels (2, 4)–(10, 10)
+        let rect = egui::Rect::from_min_max(egui::pos2(1.0, 2.0), egui::pos2(5.0, 5.0));
+        save_screenshot(&image, Some(rect), 2.0, &path).unwrap();
+        let saved = image::open(&path).unwrap().to_rgba8();
+        assert_eq!(saved.dimensions(), (8, 6));
+        assert_eq!(saved.get_pixel(0, 0).0, [2, 4, 7, 255]);
+        assert_eq!(saved.get_pixel(7, 5).0, [9, 9, 7, 255]);
+        assert!(save_screenshot(
+            &image,
+            Some(egui::Rect::from_min_max(egui::pos2(30.0, 30.0), egui::pos2(40.0, 40.0))),
+            1.0,
+            &path
+        )
+        .is_err());
+    }
+
+    #[test]
+    fn screenshot_paths_are_checked_before_the_window_opens() {
+        let dir = std::env::temp_dir().join(format!("gi-shot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        assert!(check_screenshot_path(&dir.join("x.jpg"), false).unwrap_err().to_string().contains(".png"));
+        assert!(check_screenshot_path(&dir.join("missing/x.png"), false).unwrap_err().to_string().contains("folder"));
+        let theirs = dir.join("theirs.png");
+        std::fs::write(&theirs, "not ours").unwrap();
+        assert!(check_screenshot_path(&theirs, false).unwrap_err().to_string().contains("--force"));
+        check_screenshot_path(&theirs, true).unwrap();
+        check_screenshot_path(&dir.join("new.png"), false).unwrap();
+    }
+}
