@@ -22,6 +22,7 @@ use super::storage::StateFile;
 use super::viewport::viewport_ui;
 use super::StudioArgs;
 use crate::limits;
+use crate::render::image::ImageFormat;
 use crate::render::{Algorithm, LinearImage, RenderSettings};
 use crate::scene::{load_scene, presets, save_scene, to_ron, Invalid, Scene};
 
@@ -433,6 +434,10 @@ impl StudioApp {
     /// Save the window (or, for the comparison sheet, the panes' area with
     /// their labels) as PNG at the next frame.
     pub fn take_screenshot(&mut self, path: PathBuf, crop: Option<egui::Rect>) {
+        if !matches!(ImageFormat::of(&path), Ok(ImageFormat::Png)) {
+            self.error = Some(format!("{}: screenshots are PNG files (end the name in .png)", path.display()));
+            return;
+        }
         self.screenshot = Some(ScreenshotRequest::new(path, crop));
     }
 
