@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use gi_studio::geometry::{intersect_sphere, Ray};
-use gi_studio::render::rng::Sampler;
-use gi_studio::render::sampling::uniform_sphere;
+use gi_studio::render::world::rng::Sampler;
+use gi_studio::render::world::sampling::uniform_sphere;
 use gi_studio::render::{render_blocking, Algorithm, RenderEvent, RenderJob, RenderSession, RenderSettings};
 use gi_studio::scene::presets;
 use glam::Vec3;

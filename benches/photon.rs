@@ -6,9 +6,9 @@ use std::hint::black_box;
 use std::num::NonZero;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use gi_studio::photon::trace::{trace_photons, MapKind};
-use gi_studio::photon::{Neighbours, Photon, PhotonKdTree};
-use gi_studio::render::rng::Sampler;
+use gi_studio::render::integrators::photon_map::trace::{trace_photons, MapKind};
+use gi_studio::render::integrators::photon_map::{Neighbours, Photon, PhotonKdTree};
+use gi_studio::render::world::rng::Sampler;
 use gi_studio::render::world::World;
 use gi_studio::scene::presets;
 use glam::Vec3;

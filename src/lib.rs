@@ -9,6 +9,5 @@ pub mod cli;
 pub mod fileio;
 pub mod geometry;
 pub mod limits;
-pub mod photon;
 pub mod render;
 pub mod scene;

@@ -7,9 +7,10 @@ use std::sync::Arc;
 
 use common::*;
 use gi_studio::geometry::Ray;
-use gi_studio::render::rng::Sampler;
+use gi_studio::render::integrators::{path, whitted, Counters};
+use gi_studio::render::world::rng::Sampler;
 use gi_studio::render::world::World;
-use gi_studio::render::{path, render_blocking, whitted, Algorithm, Counters, RenderJob, RenderSettings};
+use gi_studio::render::{render_blocking, Algorithm, RenderJob, RenderSettings};
 use gi_studio::scene::{LightKind, MaterialModel, Shape};
 use glam::Vec3;
 
@@ -101,7 +102,7 @@ fn whitted_phong_sphere_matches_the_hand_computation() {
     );
     scene.ambient = Vec3::splat(0.1);
     let world = World::new(&scene);
-    let camera = gi_studio::render::camera::CameraModel::new(&scene.camera, 64, 48);
+    let camera = gi_studio::render::world::camera::CameraModel::new(&scene.camera, 64, 48);
     for (px, py) in [(32.0, 24.0), (36.5, 20.5), (28.0, 27.0), (34.0, 22.0)] {
         let ray = camera.pixel_ray(px, py);
         // Oracle in f64: hit point, normal, light and view vectors
@@ -164,7 +165,7 @@ fn floor_under_a_giant_light_sphere() {
     );
     scene.camera.fov_y_degrees = 30.0;
     let image = render(scene.clone(), Algorithm::Path, 2048);
-    let camera = gi_studio::render::camera::CameraModel::new(&scene.camera, 32, 24);
+    let camera = gi_studio::render::world::camera::CameraModel::new(&scene.camera, 32, 24);
     for target in [Vec3::new(0.0, 0.0, -0.5), Vec3::new(0.3, 0.0, -0.2), Vec3::new(-0.3, 0.0, 0.2)] {
         let p = camera.project(target).unwrap();
         let got = image.get(p.x as u32, p.y as u32)[0] as f64;
@@ -216,7 +217,7 @@ fn floor_under_a_light_poking_through_the_ceiling() {
     };
 
     // The world samples exactly that cap: 1 − cos θ of the rim seen from the light's centre
-    let camera = gi_studio::render::camera::CameraModel::new(&scene.camera, 32, 24);
+    let camera = gi_studio::render::world::camera::CameraModel::new(&scene.camera, 32, 24);
     let (world, _) = World::for_view(&scene, &camera, 32, 24);
     let cap = world.emitting_cap(1);
     let expected_cap = 1.0 - (y_light - h) / radius;

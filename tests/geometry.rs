@@ -2,8 +2,8 @@
 //! hard case 5 in hard_cases.rs).
 
 use gi_studio::geometry::{intersect_sphere, Ray};
-use gi_studio::render::rng::Sampler;
-use gi_studio::render::sampling::uniform_sphere;
+use gi_studio::render::world::rng::Sampler;
+use gi_studio::render::world::sampling::uniform_sphere;
 use glam::{DVec3, Vec3};
 
 fn random_direction(s: &mut Sampler) -> Vec3 {
@@ -25,7 +25,7 @@ fn sphere_oracle(o: DVec3, d: DVec3, c: DVec3, r: f64) -> Option<f64> {
 #[test]
 fn smallpt_walls_agree_with_the_oracle_for_camera_rays() {
     let scene = gi_studio::scene::presets::preset("smallpt").unwrap().unwrap();
-    let camera = gi_studio::render::camera::CameraModel::new(&scene.camera, 64, 48);
+    let camera = gi_studio::render::world::camera::CameraModel::new(&scene.camera, 64, 48);
     let walls: Vec<(Vec3, f32)> = scene
         .objects
         .iter()

@@ -2,7 +2,7 @@
 //! awkward ones: duplicates, all points equal, k > n, n = 0 and 1, a radius
 //! that excludes everything, and the normal filter.
 
-use gi_studio::photon::{Neighbours, Photon, PhotonKdTree};
+use gi_studio::render::integrators::photon_map::{Neighbours, Photon, PhotonKdTree};
 use glam::Vec3;
 use proptest::prelude::*;
 

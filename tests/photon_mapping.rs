@@ -9,10 +9,12 @@ use std::sync::Arc;
 
 use common::*;
 use gi_studio::analysis::metrics::{rel_mse, RelMseOptions};
-use gi_studio::photon::file::{load_photon_maps, save_photon_maps, settings_key, PhotonFileError};
-use gi_studio::photon::trace::{trace_photons, MapKind};
-use gi_studio::photon::PhotonMaps;
-use gi_studio::render::camera::CameraModel;
+use gi_studio::render::integrators::photon_map::file::{
+    load_photon_maps, save_photon_maps, settings_key, PhotonFileError,
+};
+use gi_studio::render::integrators::photon_map::trace::{trace_photons, MapKind};
+use gi_studio::render::integrators::photon_map::PhotonMaps;
+use gi_studio::render::world::camera::CameraModel;
 use gi_studio::render::world::World;
 use gi_studio::render::{
     render_blocking, Algorithm, LinearImage, RenderEvent, RenderJob, RenderSession, RenderSettings,
@@ -229,7 +231,7 @@ fn damaged_photon_maps_are_refused_each_with_its_own_message() {
     }
     let resealed = |mut b: Vec<u8>| {
         let end = b.len() - 8;
-        let sum = gi_studio::photon::file::checksum(&b[..end]);
+        let sum = gi_studio::render::integrators::photon_map::file::checksum(&b[..end]);
         b[end..].copy_from_slice(&sum.to_le_bytes());
         b
     };

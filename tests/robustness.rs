@@ -286,7 +286,7 @@ fn any_bytes_as_a_photon_map_are_refused() {
             }
             bytes.extend(tail);
             std::fs::write(&path, &bytes).unwrap();
-            prop_assert!(gi_studio::photon::file::load_photon_maps(&path, 1, 2).is_err());
+            prop_assert!(gi_studio::render::integrators::photon_map::file::load_photon_maps(&path, 1, 2).is_err());
         });
     });
 }

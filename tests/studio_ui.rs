@@ -9,7 +9,7 @@ use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use gi_studio::app::StudioArgs;
 use gi_studio::app::{Selection, StudioApp};
-use gi_studio::render::camera::CameraModel;
+use gi_studio::render::world::camera::CameraModel;
 use gi_studio::scene::Shape;
 
 fn studio(panes: usize) -> Harness<'static, StudioApp> {

@@ -193,7 +193,7 @@ pub fn false_colour(values: &[f64], max: f64) -> Vec<[u8; 4]> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::rng::Sampler;
+    use crate::render::world::rng::Sampler;
 
     fn image(w: u32, h: u32, f: impl Fn(u32, u32) -> [f32; 3]) -> LinearImage {
         LinearImage {

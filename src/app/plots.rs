@@ -5,7 +5,7 @@ use eframe::egui;
 use egui_plot::{Bar, BarChart, Legend, Line, Plot};
 
 use super::pane::Pane;
-use crate::photon::maps::RADIUS_BINS;
+use crate::render::integrators::photon_map::maps::RADIUS_BINS;
 
 pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
     // A fixed height: plots asking for all the space would push the panes out

@@ -7,7 +7,7 @@ use glam::{Quat, Vec3};
 
 use super::inspector::Selection;
 use super::pane::Pane;
-use crate::render::camera::CameraModel;
+use crate::render::world::camera::CameraModel;
 use crate::render::world::World;
 use crate::scene::{Camera, Scene};
 

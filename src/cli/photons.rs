@@ -10,9 +10,9 @@ use indicatif::ProgressBar;
 use super::outputs::Outputs;
 use super::render::map_line;
 use super::RenderFlags;
-use crate::photon::file::{save_photon_maps, settings_key, MAGIC};
-use crate::photon::PhotonMaps;
-use crate::render::camera::CameraModel;
+use crate::render::integrators::photon_map::file::{save_photon_maps, settings_key, MAGIC};
+use crate::render::integrators::photon_map::PhotonMaps;
+use crate::render::world::camera::CameraModel;
 use crate::render::world::World;
 use crate::scene::load_scene;
 

@@ -11,10 +11,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 use super::outputs::Outputs;
 use super::RenderFlags;
 use crate::fileio::SIGNATURE;
-use crate::photon::file::{load_photon_maps, settings_key};
-use crate::photon::maps::MapStats;
-use crate::photon::PhotonMapStats;
 use crate::render::image::ImageFormat;
+use crate::render::integrators::photon_map::file::{load_photon_maps, settings_key};
+use crate::render::integrators::photon_map::maps::MapStats;
+use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::{Algorithm, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
 use crate::scene::{load_scene, Scene};
 

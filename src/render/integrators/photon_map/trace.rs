@@ -6,10 +6,10 @@
 
 use rayon::prelude::*;
 
-use super::emit::{emit, emit_toward, specular_targets, EmittedPhoton, LightPicker};
-use super::record::Photon;
-use crate::render::bsdf::{Bsdf, Transport};
-use crate::render::rng::Sampler;
+use crate::render::integrators::photon_map::emit::{emit, emit_toward, specular_targets, EmittedPhoton, LightPicker};
+use crate::render::integrators::photon_map::record::Photon;
+use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::rng::Sampler;
 use crate::render::world::World;
 
 /// Which photons a map keeps.

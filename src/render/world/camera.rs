@@ -2,10 +2,10 @@
 
 use glam::{Vec2, Vec3};
 
-use super::lanes::{F8, V8};
-use super::rng::{PassStreams, Sampler};
-use super::sampling::concentric_disk;
 use crate::geometry::Ray;
+use crate::render::world::lanes::{F8, V8};
+use crate::render::world::rng::{PassStreams, Sampler};
+use crate::render::world::sampling::concentric_disk;
 use crate::scene::Camera;
 
 #[derive(Clone, Debug)]

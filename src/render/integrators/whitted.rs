@@ -10,12 +10,13 @@ use std::f32::consts::FRAC_1_PI;
 
 use glam::Vec3;
 
-use super::bsdf::{reflect, refract};
-use super::occluders::Occluders;
-use super::rng::Sampler;
-use super::world::{Hit, World};
-use super::Counters;
+use super::next_event::PathScope;
 use crate::geometry::Ray;
+use crate::render::integrators::Counters;
+use crate::render::world::bsdf::{reflect, refract};
+use crate::render::world::light::LightSample;
+use crate::render::world::rng::Sampler;
+use crate::render::world::{Hit, World};
 use crate::scene::{MaterialModel, Rgb};
 
 /// Below this path weight a reflection adds nothing visible.
@@ -23,20 +24,20 @@ const MIN_WEIGHT: f32 = 1e-3;
 
 /// Radiance along a camera ray, recursing at most `max_depth` times.
 pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
-    trace(Occluders::for_path(world, ray.origin), ray, max_depth, 1.0, sampler, counters)
+    trace(PathScope::new(world, ray.origin), ray, max_depth, 1.0, sampler, counters)
 }
 
-/// The recursion, for a path that started where `occluders` was made;
-/// `weight` is what its result is multiplied by on the way to the camera.
+/// The recursion, for a path seen as `scope` sees it; `weight` is what its
+/// result is multiplied by on the way to the camera.
 fn trace(
-    occluders: Occluders,
+    scope: PathScope,
     ray: &Ray,
     depth_left: u32,
     weight: f32,
     sampler: &mut Sampler,
     counters: &mut Counters,
 ) -> Rgb {
-    let world = occluders.world();
+    let world = scope.world;
     counters.rays += 1;
     let Some(hit) = world.intersect(ray, f32::INFINITY) else {
         return world.background;
@@ -48,25 +49,17 @@ fn trace(
     match *world.material_of(&hit) {
         MaterialModel::Emissive { .. } => world.emitted(&hit, wo),
         MaterialModel::Lambert { albedo } => {
-            albedo * world.ambient
-                + local(occluders, &hit, facing, wo, albedo, Rgb::ZERO, 0.0, false, sampler, counters)
+            albedo * world.ambient + local(scope, &hit, facing, wo, albedo, Rgb::ZERO, 0.0, false, sampler, counters)
         }
         MaterialModel::Phong { ka, kd, ks, shininess } | MaterialModel::BlinnPhong { ka, kd, ks, shininess } => {
             let blinn = matches!(world.material_of(&hit), MaterialModel::BlinnPhong { .. });
             let mut c =
-                ka * world.ambient + local(occluders, &hit, facing, wo, kd, ks, shininess, blinn, sampler, counters);
+                ka * world.ambient + local(scope, &hit, facing, wo, kd, ks, shininess, blinn, sampler, counters);
             // The thesis' loop: the surface's reflectivity scales a mirror bounce
             let w = weight * ks.max_element();
             if can_recurse && w > MIN_WEIGHT {
                 c += ks
-                    * trace(
-                        occluders,
-                        &hit.surface.spawn_ray(reflect(wo, facing)),
-                        depth_left - 1,
-                        w,
-                        sampler,
-                        counters,
-                    );
+                    * trace(scope, &hit.surface.spawn_ray(reflect(wo, facing)), depth_left - 1, w, sampler, counters);
             }
             c
         }
@@ -75,7 +68,7 @@ fn trace(
             if !can_recurse || w <= MIN_WEIGHT {
                 return Rgb::ZERO;
             }
-            tint * trace(occluders, &hit.surface.spawn_ray(reflect(wo, facing)), depth_left - 1, w, sampler, counters)
+            tint * trace(scope, &hit.surface.spawn_ray(reflect(wo, facing)), depth_left - 1, w, sampler, counters)
         }
         MaterialModel::Glass { ior, tint } => {
             if !can_recurse {
@@ -86,7 +79,7 @@ fn trace(
             let mut c = Rgb::ZERO;
             if weight * fresnel > MIN_WEIGHT {
                 let reflected = trace(
-                    occluders,
+                    scope,
                     &hit.surface.spawn_ray(reflect(wo, facing)),
                     depth_left - 1,
                     weight * fresnel,
@@ -99,7 +92,7 @@ fn trace(
                 let w = weight * (1.0 - fresnel);
                 if w > MIN_WEIGHT {
                     // Radiance is compressed by η² crossing into the denser side
-                    let through = trace(occluders, &hit.surface.spawn_ray(wt), depth_left - 1, w, sampler, counters);
+                    let through = trace(scope, &hit.surface.spawn_ray(wt), depth_left - 1, w, sampler, counters);
                     c += (1.0 - fresnel) * eta * eta * through;
                 }
             }
@@ -111,7 +104,7 @@ fn trace(
 /// The local model summed over lights that see the point.
 #[allow(clippy::too_many_arguments)]
 fn local(
-    occluders: Occluders,
+    scope: PathScope,
     hit: &Hit,
     n: Vec3,
     wo: Vec3,
@@ -122,20 +115,16 @@ fn local(
     sampler: &mut Sampler,
     counters: &mut Counters,
 ) -> Rgb {
-    let world = occluders.world();
     let mut total = Rgb::ZERO;
-    for light in &world.lights {
-        let Some(sample) = light.sample(world, &hit.surface, sampler.next_2d()) else {
+    for light in &scope.world.lights {
+        // Lights behind the surface are skipped (a NaN goes on, to be counted and dropped)
+        let facing = |sample: &LightSample| {
+            let cos = n.dot(sample.wi);
+            (cos > 0.0 || cos.is_nan()).then_some(cos)
+        };
+        let Some((sample, cos)) = scope.light_sample(light, hit, sampler.next_2d(), counters, facing) else {
             continue;
         };
-        let cos = n.dot(sample.wi);
-        if cos <= 0.0 {
-            continue;
-        }
-        counters.rays += 1;
-        if occluders.blocks(&sample) {
-            continue;
-        }
         let light_colour = sample.value * FRAC_1_PI;
         let mut c = kd * cos;
         if ks != Rgb::ZERO {

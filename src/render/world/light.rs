@@ -1,12 +1,91 @@
 //! Light sources as the renderer samples them: delta lights (point, spot,
-//! directional) and emissive spheres and triangles (area lights).
+//! directional) and emissive spheres and triangles (area lights). Each
+//! carries the geometry it is sampled on, so sampling needs nothing else.
 
 use glam::{Vec2, Vec3};
 
 use super::sampling::{uniform_cone, uniform_cone_pdf, uniform_triangle};
-use super::world::{ShapeRef, World};
-use crate::geometry::{Frame, Ray, SurfaceHit};
+use crate::geometry::{Frame, Ray, SurfaceHit, Triangle};
 use crate::scene::{Attenuation, Rgb};
+
+/// The part of a sphere that can light the scene: a cap about `frame.z`
+/// (from the centre), `one_minus_cos` its 1 − cos θ: 2 for the whole sphere,
+/// 0 for none. Light sampling draws only the cap and MIS leaves the rest to
+/// BSDF sampling, so there a cap that is too small costs noise, not light;
+/// photons leave only from the cap, so it must hold all that can be seen.
+#[derive(Clone, Copy, Debug)]
+pub struct EmitterCap {
+    pub frame: Frame,
+    pub one_minus_cos: f32,
+    /// The sphere whose inside the cap was cut to, if any.
+    pub wall: Option<u32>,
+}
+
+impl EmitterCap {
+    pub const WHOLE: EmitterCap =
+        EmitterCap { frame: Frame { x: Vec3::X, y: Vec3::Y, z: Vec3::Z }, one_minus_cos: 2.0, wall: None };
+
+    /// The part of the sphere (`center`, `radius`) inside the sphere
+    /// (`other`, `other_radius`): |p − c_o| ≤ R_o on the first sphere ⇔
+    /// cos θ ≥ (r² + d² − R_o²)/(2 r d) about the axis toward c_o. In f64:
+    /// with smallpt's walls the terms are near 1e10 and differ by 1e8.
+    pub fn inside(center: Vec3, radius: f32, other: Vec3, other_radius: f32) -> Self {
+        let to_other = other.as_dvec3() - center.as_dvec3();
+        let (d, r, big) = (to_other.length(), radius as f64, other_radius as f64);
+        let (axis, cos_min) = if d > 0.0 {
+            ((to_other / d).as_vec3(), (r * r + d * d - big * big) / (2.0 * r * d))
+        } else {
+            // Concentric: all inside or nothing
+            (Vec3::Z, if r < big { -1.0 } else { 1.0 })
+        };
+        let one_minus_cos = (1.0 - cos_min).clamp(0.0, 2.0) as f32;
+        if one_minus_cos >= 2.0 {
+            return Self::WHOLE;
+        }
+        EmitterCap { frame: Frame::from_z(axis), one_minus_cos, wall: None }
+    }
+
+    pub fn is_whole(&self) -> bool {
+        self.one_minus_cos >= 2.0
+    }
+
+    /// Area of the cap on a sphere of `radius`.
+    #[inline]
+    pub fn area(&self, radius: f32) -> f32 {
+        2.0 * std::f32::consts::PI * radius * radius * self.one_minus_cos
+    }
+}
+
+/// The surface an area light is sampled on.
+#[derive(Clone, Copy, Debug)]
+pub enum Emitter {
+    /// Sphere `sphere` of the world, emitting from `cap`.
+    Sphere { sphere: u32, center: Vec3, radius: f32, cap: EmitterCap },
+    /// Triangle `triangle` of the world.
+    Triangle { triangle: u32, shape: Triangle },
+}
+
+impl Emitter {
+    /// The emitting area.
+    pub fn area(&self) -> f32 {
+        match self {
+            Emitter::Sphere { radius, cap, .. } => cap.area(*radius),
+            Emitter::Triangle { shape, .. } => shape.area(),
+        }
+    }
+
+    /// Bound on the error of points computed on it.
+    #[inline]
+    pub fn error(&self) -> f32 {
+        match self {
+            Emitter::Sphere { center, radius, .. } => crate::geometry::gamma(6) * (center.abs().max_element() + radius),
+            Emitter::Triangle { shape, .. } => {
+                let [a, b, c] = shape.vertices;
+                crate::geometry::gamma(7) * (a.abs() + b.abs() + c.abs()).max_element()
+            }
+        }
+    }
+}
 
 #[derive(Clone, Debug)]
 pub enum LightSource {
@@ -31,6 +110,7 @@ pub enum LightSource {
     Area {
         object: u32,
         radiance: Rgb,
+        emitter: Emitter,
     },
 }
 
@@ -89,7 +169,7 @@ impl LightSource {
 
     /// Sample light arriving at `at` (a surface hit, for its offset origin).
     #[inline]
-    pub fn sample(&self, world: &World, at: &SurfaceHit, u: Vec2) -> Option<LightSample> {
+    pub fn sample(&self, at: &SurfaceHit, u: Vec2) -> Option<LightSample> {
         let p = at.point;
         match *self {
             LightSource::Point { position, intensity, attenuation } => {
@@ -109,17 +189,16 @@ impl LightSource {
             LightSource::Directional { direction, irradiance } => {
                 Some(LightSample::delta(at.spawn_ray(-direction), f32::INFINITY, irradiance))
             }
-            LightSource::Area { object, radiance } => {
-                let (target, normal, error, pdf) = sample_area(world, object, p, u)?;
+            LightSource::Area { radiance, ref emitter, .. } => {
+                let (target, normal, error, pdf) = sample_area(emitter, p, u)?;
                 let (shadow, shadow_t_max) = at.spawn_ray_to(target, error);
                 // Emission is one-sided: the light's front must face the point
                 if normal.dot(-shadow.direction) <= 0.0 || pdf.is_nan() || pdf <= 0.0 {
                     return None;
                 }
-                let (on_triangle, on_sphere) = match world.objects[object as usize].shape {
-                    ShapeRef::Triangle(t) => (Some(t), None),
-                    ShapeRef::Sphere(i) => (None, Some(i)),
-                    ShapeRef::Plane(_) => (None, None),
+                let (on_triangle, on_sphere) = match *emitter {
+                    Emitter::Triangle { triangle, .. } => (Some(triangle), None),
+                    Emitter::Sphere { sphere, .. } => (None, Some(sphere)),
                 };
                 Some(LightSample {
                     wi: shadow.direction,
@@ -139,17 +218,14 @@ impl LightSource {
 /// bound, solid-angle pdf at `p`). Spheres seen from outside are sampled by
 /// the cone they subtend (every sample can be visible); triangles by area.
 #[inline]
-fn sample_area(world: &World, object: u32, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32, f32)> {
-    match world.objects[object as usize].shape {
-        ShapeRef::Sphere(i) => {
-            let i = i as usize;
-            let (center, radius) = (world.spheres.center(i), world.spheres.radius[i]);
-            let cap = world.emitting_cap(i);
+fn sample_area(emitter: &Emitter, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32, f32)> {
+    match *emitter {
+        Emitter::Sphere { center, radius, cap, .. } => {
             if !cap.is_whole() {
                 // Only part of the light can be seen: uniform over that cap
                 let normal = cap.frame.to_world(uniform_cone(u, cap.one_minus_cos));
                 let point = center + normal * radius;
-                let error = crate::geometry::gamma(6) * (center.abs().max_element() + radius);
+                let error = emitter.error();
                 let pdf = solid_angle_pdf(p, point, normal, cap.area(radius));
                 return (pdf > 0.0).then_some((point, normal, error, pdf));
             }
@@ -173,22 +249,19 @@ fn sample_area(world: &World, object: u32, p: Vec3, u: Vec2) -> Option<(Vec3, Ve
                         t,
                         point: center + (ray.at(t) - center).normalize() * radius,
                         normal: (ray.at(t) - center).normalize(),
-                        error: crate::geometry::gamma(6) * (center.abs().max_element() + radius),
+                        error: emitter.error(),
                     }
                 }
             };
             Some((hit.point, hit.normal, hit.error, uniform_cone_pdf(one_minus_cos)))
         }
-        ShapeRef::Triangle(t) => {
-            let triangle = &world.triangles[t as usize].0;
+        Emitter::Triangle { shape: ref triangle, .. } => {
             let (b0, b1) = uniform_triangle(u);
             let [a, b, c] = triangle.vertices;
             let point = a * b0 + b * b1 + c * (1.0 - b0 - b1);
-            let error = crate::geometry::gamma(7) * (a.abs() + b.abs() + c.abs()).max_element();
             let pdf = solid_angle_pdf(p, point, triangle.normal, triangle.area());
-            (pdf > 0.0).then_some((point, triangle.normal, error, pdf))
+            (pdf > 0.0).then_some((point, triangle.normal, emitter.error(), pdf))
         }
-        ShapeRef::Plane(_) => None,
     }
 }
 
@@ -206,43 +279,48 @@ fn solid_angle_pdf(p: Vec3, point: Vec3, normal: Vec3, area: f32) -> f32 {
     }
 }
 
-/// Solid-angle pdf with which `sample` would have chosen the point `hit` on
-/// area light `object` from `p` (for MIS on BSDF-sampled hits).
-#[inline]
-pub fn area_pdf(world: &World, object: u32, p: Vec3, hit: &SurfaceHit) -> f32 {
-    match world.objects[object as usize].shape {
-        ShapeRef::Sphere(i) => {
-            let i = i as usize;
-            let (center, radius) = (world.spheres.center(i), world.spheres.radius[i]);
-            let cap = world.emitting_cap(i);
-            if !cap.is_whole() {
-                // Light sampling reaches only the cap: elsewhere its pdf is 0
-                let normal = (hit.point - center) / radius;
-                if normal.dot(cap.frame.z) < 1.0 - cap.one_minus_cos {
+impl LightSource {
+    /// Solid-angle pdf with which `sample` would have chosen the point `hit`
+    /// from `p` (for MIS on BSDF-sampled hits of an area light; 0 otherwise).
+    #[inline]
+    pub fn pdf(&self, p: Vec3, hit: &SurfaceHit) -> f32 {
+        let LightSource::Area { emitter, .. } = self else { return 0.0 };
+        match *emitter {
+            Emitter::Sphere { center, radius, cap, .. } => {
+                if !cap.is_whole() {
+                    // Light sampling reaches only the cap: elsewhere its pdf is 0
+                    let normal = (hit.point - center) / radius;
+                    if normal.dot(cap.frame.z) < 1.0 - cap.one_minus_cos {
+                        return 0.0;
+                    }
+                    return solid_angle_pdf(p, hit.point, normal, cap.area(radius));
+                }
+                let distance2 = (center - p).length_squared();
+                let sin2_max = radius * radius / distance2;
+                if sin2_max >= 1.0 {
                     return 0.0;
                 }
-                return solid_angle_pdf(p, hit.point, normal, cap.area(radius));
+                uniform_cone_pdf(sin2_max / (1.0 + (1.0 - sin2_max).sqrt()))
             }
-            let distance2 = (center - p).length_squared();
-            let sin2_max = radius * radius / distance2;
-            if sin2_max >= 1.0 {
-                return 0.0;
-            }
-            uniform_cone_pdf(sin2_max / (1.0 + (1.0 - sin2_max).sqrt()))
+            Emitter::Triangle { ref shape, .. } => solid_angle_pdf(p, hit.point, shape.normal, shape.area()),
         }
-        ShapeRef::Triangle(t) => {
-            let triangle = &world.triangles[t as usize].0;
-            solid_angle_pdf(p, hit.point, triangle.normal, triangle.area())
+    }
+
+    /// The emitting sphere's cap, for a light on a sphere.
+    pub fn cap(&self) -> Option<EmitterCap> {
+        match self {
+            LightSource::Area { emitter: Emitter::Sphere { cap, .. }, .. } => Some(*cap),
+            _ => None,
         }
-        ShapeRef::Plane(_) => 0.0,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::camera::CameraModel;
-    use crate::render::rng::Sampler;
+    use crate::render::world::camera::CameraModel;
+    use crate::render::world::rng::Sampler;
+    use crate::render::world::World;
 
     /// smallpt's light is a sphere of radius 600 poking 0.27 through the
     /// ceiling. Light samples taken in the room land on the part under the
@@ -259,7 +337,7 @@ mod tests {
             // A point on whatever is below a random spot in the room
             let above = Vec3::new(5.0 + 90.0 * s.next_f32(), 60.0, 10.0 + 140.0 * s.next_f32());
             let Some(hit) = world.intersect(&Ray::new(above, -Vec3::Y), f32::INFINITY) else { continue };
-            let Some(sample) = world.lights[0].sample(&world, &hit.surface, s.next_2d()) else { continue };
+            let Some(sample) = world.lights[0].sample(&hit.surface, s.next_2d()) else { continue };
             let target = sample.shadow.at(sample.shadow_t_max).as_dvec3();
             assert!((target - ceiling).length() < 1.0e5 + 0.05, "a sample above the ceiling: {target}");
             taken += 1;

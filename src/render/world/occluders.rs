@@ -12,11 +12,11 @@
 use glam::{DVec3, Vec3};
 
 use super::lanes::{F8, LANES, M8, V8};
-use super::light::{LightSample, LightSource};
+use super::light::{Emitter, LightSample, LightSource};
+use super::shapes::{PlaneShape, Spheres};
 use super::spheres::SphereLanes;
-use super::world::{PlaneShape, ShapeRef, World};
+use crate::geometry::Triangle;
 use crate::geometry::{gamma, intersect_triangle, plane_t};
-use crate::scene::MaterialModel;
 
 /// A region a wall bounds, in f64 for exact inside tests.
 #[derive(Clone, Copy, Debug)]
@@ -101,21 +101,24 @@ pub struct Walls {
 }
 
 impl Walls {
-    /// Opaque, non-emissive spheres and planes with `eye` (where the camera's
-    /// rays start) strictly inside and every light's sample points inside;
-    /// none where a light has samples everywhere (a directional light).
-    pub fn find(world: &World, eye: Vec3) -> Self {
+    /// Opaque spheres and planes (`opaque` of their object) with `eye`
+    /// (where the camera's rays start) strictly inside and every light's
+    /// sample points inside; none where a light has samples everywhere (a
+    /// directional light).
+    pub fn find(
+        spheres: &Spheres,
+        planes: &[PlaneShape],
+        opaque: impl Fn(u32) -> bool,
+        lights: &[LightSource],
+        eye: Vec3,
+    ) -> Self {
         let eye = eye.as_dvec3();
-        let opaque = |object: u32| {
-            let material = &world.materials[world.objects[object as usize].material as usize];
-            !matches!(material, MaterialModel::Glass { .. } | MaterialModel::Emissive { .. })
-        };
         let is_wall = |region: &Region, object: u32| {
             opaque(object)
                 && region.holds_strictly(eye)
-                && world.lights.iter().all(|light| holds_samples(world, light, region, object))
+                && lights.iter().all(|light| holds_samples(spheres, light, region, object))
         };
-        let s = &world.spheres;
+        let s = spheres;
         let (mut regions, mut others) = (Vec::new(), Vec::new());
         let mut is_wall_sphere = Vec::with_capacity(s.radius.len());
         for j in 0..s.radius.len() {
@@ -128,8 +131,8 @@ impl Walls {
             }
             is_wall_sphere.push(wall);
         }
-        let mut planes = Vec::new();
-        for plane in &world.planes {
+        let mut kept_planes = Vec::new();
+        for plane in planes {
             // Facing the camera's side
             let (normal, offset) = (plane.normal.as_dvec3(), plane.offset as f64);
             let side = if normal.dot(eye) > offset { 1.0 } else { -1.0 };
@@ -137,7 +140,7 @@ impl Walls {
             if is_wall(&region, plane.object) {
                 regions.push(region);
             } else {
-                planes.push(*plane);
+                kept_planes.push(*plane);
             }
         }
         if regions.is_empty() {
@@ -146,7 +149,7 @@ impl Walls {
         let centers: Vec<Vec3> = others.iter().map(|&j| s.center(j)).collect();
         let radii: Vec<f32> = others.iter().map(|&j| s.radius[j]).collect();
         let ids = others.iter().map(|&j| j as u32).collect();
-        Walls { regions, spheres: SphereLanes::new(&centers, &radii, ids), planes, is_wall_sphere }
+        Walls { regions, spheres: SphereLanes::new(&centers, &radii, ids), planes: kept_planes, is_wall_sphere }
     }
 
     /// Whether a path starting at `origin` is inside every wall (and there are walls).
@@ -196,21 +199,19 @@ impl Walls {
 
 /// Whether every sample `light` can give lies in `region`, the inside of
 /// the wall `object`.
-fn holds_samples(world: &World, light: &LightSource, region: &Region, object: u32) -> bool {
+fn holds_samples(spheres: &Spheres, light: &LightSource, region: &Region, object: u32) -> bool {
     match *light {
         LightSource::Point { position, .. } | LightSource::Spot { position, .. } => {
             region.holds(position.as_dvec3(), 0.0)
         }
         LightSource::Directional { .. } => false,
-        LightSource::Area { object: emitter, .. } => match world.objects[emitter as usize].shape {
-            ShapeRef::Sphere(i) => {
-                let i = i as usize;
-                let cap = world.emitting_cap(i);
-                if cap.wall.is_some_and(|wall| world.spheres.object[wall as usize] == object) {
+        LightSource::Area { ref emitter, .. } => match *emitter {
+            Emitter::Sphere { center, radius, cap, .. } => {
+                if cap.wall.is_some_and(|wall| spheres.object[wall as usize] == object) {
                     // Cut to this wall's inside: in it by construction
                     return true;
                 }
-                let (c, r) = (world.spheres.center(i).as_dvec3(), world.spheres.radius[i] as f64);
+                let (c, r) = (center.as_dvec3(), radius as f64);
                 let cos_min = 1.0 - cap.one_minus_cos as f64;
                 if cos_min > 0.0 {
                     // The ball on the cap's rim circle holds the cap
@@ -220,10 +221,7 @@ fn holds_samples(world: &World, light: &LightSource, region: &Region, object: u3
                     region.holds(c, r)
                 }
             }
-            ShapeRef::Triangle(t) => {
-                world.triangles[t as usize].0.vertices.iter().all(|v| region.holds(v.as_dvec3(), 0.0))
-            }
-            ShapeRef::Plane(_) => false,
+            Emitter::Triangle { ref shape, .. } => shape.vertices.iter().all(|v| region.holds(v.as_dvec3(), 0.0)),
         },
     }
 }
@@ -231,36 +229,38 @@ fn holds_samples(world: &World, light: &LightSource, region: &Region, object: u3
 /// What can block the shadow rays of one path.
 #[derive(Clone, Copy)]
 pub struct Occluders<'w> {
-    world: &'w World,
     spheres: &'w SphereLanes,
     planes: &'w [PlaneShape],
+    triangles: &'w [(Triangle, u32)],
+    /// Per triangle, the light triangle whose plane holds it (`u32::MAX` if none).
+    light_plane: &'w [u32],
 }
 
 impl<'w> Occluders<'w> {
-    /// For a path whose camera ray starts at `origin`.
+    /// For a path whose camera ray starts at `origin`: without the walls
+    /// when it starts inside them all.
     #[inline]
-    pub fn for_path(world: &'w World, origin: Vec3) -> Self {
-        let walls = &world.walls;
-        if walls.hold(origin) {
-            Occluders { world, spheres: &walls.spheres, planes: &walls.planes }
-        } else {
-            Occluders { world, spheres: &world.spheres.lanes, planes: &world.planes }
-        }
-    }
-
-    pub fn world(&self) -> &'w World {
-        self.world
+    pub fn for_path(
+        walls: &'w Walls,
+        spheres: &'w SphereLanes,
+        planes: &'w [PlaneShape],
+        triangles: &'w [(Triangle, u32)],
+        light_plane: &'w [u32],
+        origin: Vec3,
+    ) -> Self {
+        let (spheres, planes) =
+            if walls.hold(origin) { (&walls.spheres, &walls.planes[..]) } else { (spheres, planes) };
+        Occluders { spheres, planes, triangles, light_plane }
     }
 
     /// Whether anything lies between the shading point and the light sample.
     #[inline]
     pub fn blocks(&self, sample: &LightSample) -> bool {
         let (ray, t_max) = (&sample.shadow, sample.shadow_t_max);
-        let world = self.world;
-        let light_plane = sample.on_triangle.map(|t| world.light_plane[t as usize]);
+        let light_plane = sample.on_triangle.map(|t| self.light_plane[t as usize]);
         self.spheres.any_hit_except(ray, t_max, sample.on_sphere)
             || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
-            || world.triangles.iter().zip(&world.light_plane).any(|((triangle, _), plane)| {
+            || self.triangles.iter().zip(self.light_plane).any(|((triangle, _), plane)| {
                 light_plane != Some(*plane) && intersect_triangle(ray, triangle, t_max).is_some()
             })
     }
@@ -270,9 +270,10 @@ impl<'w> Occluders<'w> {
 mod tests {
     use super::*;
     use crate::geometry::{sphere_t, Ray};
-    use crate::render::camera::CameraModel;
-    use crate::render::rng::Sampler;
-    use crate::render::sampling::uniform_sphere;
+    use crate::render::world::camera::CameraModel;
+    use crate::render::world::rng::Sampler;
+    use crate::render::world::sampling::uniform_sphere;
+    use crate::render::world::World;
     use crate::scene::{Light, LightKind, Scene};
 
     fn preset(name: &str) -> Scene {
@@ -324,8 +325,8 @@ mod tests {
     #[test]
     fn paths_from_outside_test_every_sphere() {
         let w = world(&preset("smallpt"));
-        assert_eq!(Occluders::for_path(&w, Vec3::new(50.0, 52.0, 150.0)).spheres.len(), 3);
-        assert_eq!(Occluders::for_path(&w, Vec3::new(50.0, 82.0, 150.0)).spheres.len(), 9);
+        assert_eq!(w.occluders(Vec3::new(50.0, 52.0, 150.0)).spheres.len(), 3);
+        assert_eq!(w.occluders(Vec3::new(50.0, 82.0, 150.0)).spheres.len(), 9);
     }
 
     /// The f32 shortcut answers as f64 does, on points within a few ulps of
@@ -376,7 +377,7 @@ mod tests {
     /// the f32 test cannot call it, and a NaN.
     #[test]
     fn walls_hold_lanes_as_they_hold_points() {
-        assert!(crate::render::lanes::supported(), "the lanes need AVX2");
+        assert!(crate::render::world::lanes::supported(), "the lanes need AVX2");
         let w = world(&preset("smallpt"));
         let mut s = Sampler::new(4, 5, 6);
         let (low, high) = (Vec3::new(-1.0, -1.0, -1.0), Vec3::new(101.0, 83.0, 172.0));
@@ -456,7 +457,7 @@ mod tests {
             let (mut samples, mut blocked, mut skipping_paths, mut leaks) = (0u32, 0u32, 0u32, 0u32);
             for _ in 0..4000 {
                 let mut ray = camera.pixel_ray(64.0 * s.next_f32(), 48.0 * s.next_f32());
-                let occluders = Occluders::for_path(&w, ray.origin);
+                let occluders = w.occluders(ray.origin);
                 let skips = occluders.spheres.len() + occluders.planes.len() < w.spheres.lanes.len() + w.planes.len();
                 skipping_paths += skips as u32;
                 for _ in 0..4 {
@@ -468,7 +469,7 @@ mod tests {
                         break;
                     }
                     for light in &w.lights {
-                        let Some(sample) = light.sample(&w, &hit.surface, s.next_2d()) else { continue };
+                        let Some(sample) = light.sample(&hit.surface, s.next_2d()) else { continue };
                         let (shadow, t_max) = (&sample.shadow, sample.shadow_t_max);
                         let everything = w.occluded(shadow, t_max);
                         let skipping = occluders.blocks(&sample);

@@ -8,9 +8,11 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use crate::geometry::{offset_ray_origin, Frame, Ray};
-use crate::render::light::{spot_factor, LightSource};
-use crate::render::rng::Sampler;
-use crate::render::sampling::{cosine_hemisphere, uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_triangle};
+use crate::render::world::light::{spot_factor, Emitter, LightSource};
+use crate::render::world::rng::Sampler;
+use crate::render::world::sampling::{
+    cosine_hemisphere, uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_triangle,
+};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::Rgb;
 
@@ -28,15 +30,7 @@ pub fn light_power(world: &World, light: &LightSource) -> Rgb {
             intensity * (2.0 * PI * (1.0 - cos_cone.powf(exponent + 1.0)) / (exponent + 1.0))
         }
         LightSource::Directional { irradiance, .. } => irradiance * (PI * world.bounds_radius * world.bounds_radius),
-        LightSource::Area { object, radiance } => radiance * (PI * emitter_area(world, object)),
-    }
-}
-
-fn emitter_area(world: &World, object: u32) -> f32 {
-    match world.objects[object as usize].shape {
-        ShapeRef::Sphere(i) => world.emitting_cap(i as usize).area(world.spheres.radius[i as usize]),
-        ShapeRef::Triangle(t) => world.triangles[t as usize].0.area(),
-        ShapeRef::Plane(_) => 0.0,
+        LightSource::Area { radiance, ref emitter, .. } => radiance * (PI * emitter.area()),
     }
 }
 
@@ -103,40 +97,35 @@ pub fn emit(world: &World, picker: &LightPicker, sampler: &mut Sampler) -> Optio
         LightSource::Directional { direction, irradiance } => {
             let radius = world.bounds_radius;
             let frame = Frame::from_z(direction);
-            let disc = crate::render::sampling::concentric_disk(u1) * radius;
+            let disc = crate::render::world::sampling::concentric_disk(u1) * radius;
             let origin = world.bounds_center - direction * (2.0 * radius) + frame.x * disc.x + frame.y * disc.y;
             (Ray::new(origin, direction), irradiance * (PI * radius * radius))
         }
-        LightSource::Area { object, radiance } => {
-            let (point, normal, error) = point_on_emitter(world, object, u1)?;
+        LightSource::Area { radiance, ref emitter, .. } => {
+            let (point, normal, error) = point_on_emitter(emitter, u1);
             let d = Frame::from_z(normal).to_world(cosine_hemisphere(u2));
             // Cosine-weighted: L cos θ / (pdf_area · cos θ/π) = π L A
             let origin = offset_ray_origin(point, error, normal, d);
-            (Ray::new(origin, d), radiance * (PI * emitter_area(world, object)))
+            (Ray::new(origin, d), radiance * (PI * emitter.area()))
         }
     };
     Some(EmittedPhoton { ray, power: power / pick })
 }
 
 /// A uniform point on an emitter: (point, normal, error bound).
-fn point_on_emitter(world: &World, object: u32, u: Vec2) -> Option<(Vec3, Vec3, f32)> {
-    match world.objects[object as usize].shape {
-        ShapeRef::Sphere(i) => {
-            let (center, radius) = (world.spheres.center(i as usize), world.spheres.radius[i as usize]);
+fn point_on_emitter(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f32) {
+    match *emitter {
+        Emitter::Sphere { center, radius, cap, .. } => {
             // Uniform over the emitting cap (the whole sphere when 1 − cos = 2)
-            let cap = world.emitting_cap(i as usize);
             let normal =
                 if cap.is_whole() { uniform_sphere(u) } else { cap.frame.to_world(uniform_cone(u, cap.one_minus_cos)) };
-            Some((center + normal * radius, normal, crate::geometry::gamma(6) * (center.abs().max_element() + radius)))
+            (center + normal * radius, normal, emitter.error())
         }
-        ShapeRef::Triangle(t) => {
-            let triangle = &world.triangles[t as usize].0;
+        Emitter::Triangle { shape: ref triangle, .. } => {
             let (b0, b1) = uniform_triangle(u);
             let [a, b, c] = triangle.vertices;
-            let error = crate::geometry::gamma(7) * (a.abs() + b.abs() + c.abs()).max_element();
-            Some((a * b0 + b * b1 + c * (1.0 - b0 - b1), triangle.normal, error))
+            (a * b0 + b * b1 + c * (1.0 - b0 - b1), triangle.normal, emitter.error())
         }
-        ShapeRef::Plane(_) => None,
     }
 }
 
@@ -146,7 +135,7 @@ pub fn specular_targets(world: &World) -> Vec<(Vec3, f32)> {
     world
         .objects
         .iter()
-        .filter(|o| crate::render::bsdf::Bsdf::new(&world.materials[o.material as usize]).is_specular())
+        .filter(|o| crate::render::world::bsdf::Bsdf::new(&world.materials[o.material as usize]).is_specular())
         .filter(|o| !matches!(world.materials[o.material as usize], crate::scene::MaterialModel::Emissive { .. }))
         .filter_map(|o| match o.shape {
             ShapeRef::Sphere(i) => Some((world.spheres.center(i as usize), world.spheres.radius[i as usize])),
@@ -222,7 +211,7 @@ pub fn emit_toward(
         LightSource::Directional { direction, irradiance } => {
             // A disc just covering the target, perpendicular to the light
             let frame = Frame::from_z(direction);
-            let disc = crate::render::sampling::concentric_disk(u1) * target.1;
+            let disc = crate::render::world::sampling::concentric_disk(u1) * target.1;
             let origin =
                 target.0 - direction * (2.0 * world.bounds_radius.max(target.1)) + frame.x * disc.x + frame.y * disc.y;
             // Density of origins over all targets' discs containing this line
@@ -236,15 +225,15 @@ pub fn emit_toward(
                 .sum();
             (Ray::new(origin, direction), irradiance / density)
         }
-        LightSource::Area { object, radiance } => {
-            let (point, normal, error) = point_on_emitter(world, object, u1)?;
+        LightSource::Area { radiance, ref emitter, .. } => {
+            let (point, normal, error) = point_on_emitter(emitter, u1);
             let d = cone_direction(point)?;
             let cos = normal.dot(d);
             if cos <= 0.0 {
                 return None;
             }
             let origin = offset_ray_origin(point, error, normal, d);
-            let area = emitter_area(world, object);
+            let area = emitter.area();
             (Ray::new(origin, d), radiance * (cos * area / direction_pdf(point, d)))
         }
     };

@@ -125,8 +125,8 @@ impl SphereLanes {
 mod tests {
     use super::*;
     use crate::geometry::sphere_t;
-    use crate::render::rng::Sampler;
-    use crate::render::sampling::uniform_sphere;
+    use crate::render::world::rng::Sampler;
+    use crate::render::world::sampling::uniform_sphere;
 
     /// Four-wide lanes agree with the scalar test, sphere by sphere.
     #[test]

@@ -9,11 +9,11 @@
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
-use super::kdtree::PhotonKdTree;
-use super::maps::{MapStats, PhotonMapStats, PhotonMaps};
-use super::record::Photon;
 use crate::fileio::{self, FileError};
 use crate::limits;
+use crate::render::integrators::photon_map::kdtree::PhotonKdTree;
+use crate::render::integrators::photon_map::maps::{MapStats, PhotonMapStats, PhotonMaps};
+use crate::render::integrators::photon_map::record::Photon;
 use crate::render::PhotonSettings;
 
 /// The file's first bytes; also what marks a photon map as this program's.

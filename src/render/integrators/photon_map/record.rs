@@ -120,8 +120,8 @@ impl Photon {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::rng::Sampler;
-    use crate::render::sampling::uniform_sphere;
+    use crate::render::world::rng::Sampler;
+    use crate::render::world::sampling::uniform_sphere;
 
     #[test]
     fn damaged_records_are_refused() {

@@ -3,6 +3,8 @@
 //! restart never waits for a pass to end. The studio and the CLI both drive it
 //! through a `RenderSession`.
 
+pub mod tiles;
+
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -11,19 +13,19 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender};
 use rayon::prelude::*;
 
-use super::camera::CameraModel;
-use super::image::LinearImage;
-use super::occluders::Occluders;
-use super::path_lanes::{CameraTile, PathLanes};
-use super::rng::PassStreams;
-use super::settings::{Algorithm, RenderSettings};
-use super::tiles::{tile_layout, TileAccumulator, TileRect};
-use super::world::World;
-use super::{path, whitted, Counters};
-use crate::photon::integrator::{PhotonRenderer, PhotonScratch};
-use crate::photon::sppm::camera_pass;
-use crate::photon::trace::{trace_photons, MapKind};
-use crate::photon::{PhotonKdTree, PhotonMapStats, PhotonMaps, QueryStats};
+use crate::render::engine::tiles::{tile_layout, TileAccumulator, TileRect};
+use crate::render::image::LinearImage;
+use crate::render::integrators::next_event::PathScope;
+use crate::render::integrators::path_lanes::{CameraTile, PathLanes};
+use crate::render::integrators::photon::{PhotonRenderer, PhotonScratch};
+use crate::render::integrators::photon_map::trace::{trace_photons, MapKind};
+use crate::render::integrators::photon_map::{PhotonKdTree, PhotonMapStats, PhotonMaps, QueryStats};
+use crate::render::integrators::sppm::camera_pass;
+use crate::render::integrators::{path, whitted, Counters};
+use crate::render::settings::{Algorithm, RenderSettings};
+use crate::render::world::camera::CameraModel;
+use crate::render::world::rng::PassStreams;
+use crate::render::world::World;
 use crate::scene::{Rgb, Scene};
 
 /// A scene snapshot and how to render it.
@@ -442,7 +444,7 @@ impl FrameContext<'_> {
             (Method::Photon(maps), Some(scratch)) => {
                 let renderer = PhotonRenderer {
                     world: &self.world,
-                    occluders: Occluders::for_path(&self.world, ray.origin),
+                    scope: PathScope::new(&self.world, ray.origin),
                     maps,
                     settings: &settings.photon,
                     max_depth: settings.max_depth,

@@ -13,7 +13,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use glam::Vec3;
 
-use super::rng::{mix64, unit_from_24_bits, Sampler};
+use crate::render::world::rng::{mix64, unit_from_24_bits, Sampler};
 
 pub const LANES: usize = 8;
 

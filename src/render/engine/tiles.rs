@@ -1,7 +1,7 @@
 //! The image cut into tiles, rendered centre first, each owning its own
 //! accumulation buffer so parallel passes need no locks.
 
-use crate::photon::sppm::SppmPixel;
+use crate::render::integrators::sppm::SppmPixel;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TileRect {

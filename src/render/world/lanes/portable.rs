@@ -4,7 +4,7 @@
 
 use std::ops::{Add, Div, Mul, Neg, Not, Sub};
 
-use super::{each as from_fn, LANES};
+use crate::render::world::lanes::{each as from_fn, LANES};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(32))]

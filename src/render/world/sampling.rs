@@ -141,7 +141,7 @@ mod tests {
     use std::f32::consts::FRAC_PI_2;
 
     use super::*;
-    use crate::render::rng::Sampler;
+    use crate::render::world::rng::Sampler;
 
     #[test]
     fn warps_land_where_they_should() {

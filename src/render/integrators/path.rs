@@ -2,21 +2,20 @@
 //! light per bounce, multiple importance sampling between light and BSDF
 //! sampling for area lights, Russian roulette.
 
-use super::bsdf::{Bsdf, Transport};
-use super::light::area_pdf;
-use super::occluders::Occluders;
-use super::rng::Sampler;
-use super::sampling::power_heuristic;
-use super::world::World;
+use super::next_event::PathScope;
 use super::Counters;
 use crate::geometry::Ray;
+use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::rng::Sampler;
+use crate::render::world::sampling::power_heuristic;
+use crate::render::world::World;
 use crate::scene::Rgb;
 
 /// Bounces before Russian roulette may end a path.
 pub(crate) const ROULETTE_DEPTH: u32 = 3;
 
 pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
-    let occluders = Occluders::for_path(world, ray.origin);
+    let scope = PathScope::new(world, ray.origin);
     let mut ray = *ray;
     let mut radiance = Rgb::ZERO;
     let mut throughput = Rgb::ONE;
@@ -39,8 +38,8 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
         let emitted = world.emitted(&hit, wo);
         if emitted != Rgb::ZERO {
             let weight = match world.objects[hit.object as usize].light {
-                Some(_) if !after_delta => {
-                    power_heuristic(last_pdf, pick_pdf * area_pdf(world, hit.object, last_point, &hit.surface))
+                Some(light) if !after_delta => {
+                    power_heuristic(last_pdf, pick_pdf * world.lights[light as usize].pdf(last_point, &hit.surface))
                 }
                 _ => 1.0,
             };
@@ -52,26 +51,8 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
 
         // Next-event estimation: one light, chosen uniformly
-        if !bsdf.is_specular() && light_count > 0 {
-            let pick = match light_count {
-                1 => 0,
-                _ => ((sampler.next_f32() * light_count as f32) as usize).min(light_count - 1),
-            };
-            let light = &world.lights[pick];
-            if let Some(sample) = light.sample(world, &hit.surface, sampler.next_2d()) {
-                let f = bsdf.eval(wo, sample.wi, facing);
-                if f != Rgb::ZERO {
-                    counters.rays += 1;
-                    if !occluders.blocks(&sample) {
-                        let weight = if light.is_delta() {
-                            1.0
-                        } else {
-                            power_heuristic(pick_pdf * sample.pdf, bsdf.pdf(wo, sample.wi, facing))
-                        };
-                        radiance += throughput * f * sample.value * (sample.wi.dot(facing) * weight / pick_pdf);
-                    }
-                }
-            }
+        if !bsdf.is_specular() {
+            radiance += scope.one_light(&hit, wo, facing, &bsdf, throughput, sampler, counters);
         }
 
         let Some(scattered) = bsdf.sample(wo, n, sampler, Transport::Radiance) else {

@@ -10,14 +10,13 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use super::integrator::direct_light;
-use super::kdtree::PhotonKdTree;
+use super::next_event::PathScope;
 use crate::geometry::Ray;
-use crate::render::bsdf::{Bsdf, Transport};
-use crate::render::occluders::Occluders;
-use crate::render::rng::Sampler;
+use crate::render::integrators::photon_map::kdtree::PhotonKdTree;
+use crate::render::integrators::Counters;
+use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::rng::Sampler;
 use crate::render::world::World;
-use crate::render::Counters;
 use crate::scene::Rgb;
 
 #[derive(Clone, Copy, Debug)]
@@ -92,7 +91,7 @@ pub fn camera_pass(
     sampler: &mut Sampler,
     counters: &mut Counters,
 ) -> (Rgb, Option<VisiblePoint>) {
-    let occluders = Occluders::for_path(world, ray.origin);
+    let scope = PathScope::new(world, ray.origin);
     let mut ray = *ray;
     let mut throughput = Rgb::ONE;
     let mut radiance = Rgb::ZERO;
@@ -114,7 +113,7 @@ pub fn camera_pass(
             continue;
         }
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
-        radiance += throughput * direct_light(occluders, &hit, wo, facing, &bsdf, sampler, counters);
+        radiance += throughput * scope.every_light(&hit, wo, facing, &bsdf, sampler, counters);
         if world.background != Rgb::ZERO {
             if let Some(s) = bsdf.sample(wo, n, sampler, Transport::Radiance) {
                 counters.rays += 1;
@@ -132,7 +131,7 @@ pub fn camera_pass(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::photon::Photon;
+    use crate::render::integrators::photon_map::Photon;
 
     #[test]
     fn radius_shrinks_stays_positive_and_finite_over_thousands_of_passes() {

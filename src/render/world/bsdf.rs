@@ -6,9 +6,9 @@ use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::Vec3;
 
-use super::rng::Sampler;
-use super::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power_cosine, power_cosine_pdf};
 use crate::geometry::Frame;
+use crate::render::world::rng::Sampler;
+use crate::render::world::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power_cosine, power_cosine_pdf};
 use crate::scene::{MaterialModel, Rgb};
 
 /// What a path carries through refraction: camera paths carry radiance, which

@@ -14,7 +14,7 @@ use std::arch::x86_64::*;
 use std::fmt;
 use std::ops::{Add, Div, Mul, Neg, Not, Sub};
 
-use super::LANES;
+use crate::render::world::lanes::LANES;
 
 #[derive(Clone, Copy)]
 #[repr(transparent)]
@@ -201,7 +201,7 @@ impl M8 {
 
     #[inline(always)]
     pub fn from_fn(mut f: impl FnMut(usize) -> bool) -> Self {
-        let v: [i32; LANES] = super::each(|i| -(f(i) as i32));
+        let v: [i32; LANES] = crate::render::world::lanes::each(|i| -(f(i) as i32));
         M8(unsafe { _mm256_castsi256_ps(_mm256_setr_epi32(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7])) })
     }
 

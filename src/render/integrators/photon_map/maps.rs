@@ -5,9 +5,9 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 
-use super::kdtree::{Neighbours, PhotonKdTree};
-use super::trace::{trace_photons, MapKind};
-use crate::render::bsdf::Bsdf;
+use crate::render::integrators::photon_map::kdtree::{Neighbours, PhotonKdTree};
+use crate::render::integrators::photon_map::trace::{trace_photons, MapKind};
+use crate::render::world::bsdf::Bsdf;
 use crate::render::world::World;
 use crate::render::PhotonSettings;
 use crate::scene::Rgb;

@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 
-use super::record::Photon;
+use crate::render::integrators::photon_map::record::Photon;
 
 #[derive(Debug)]
 pub struct PhotonKdTree {
@@ -281,7 +281,7 @@ impl Neighbours {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::rng::Sampler;
+    use crate::render::world::rng::Sampler;
 
     fn random_photons(n: usize, seed: u64) -> Vec<Photon> {
         let mut s = Sampler::new(0, 0, seed);

@@ -13,19 +13,19 @@ use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
-use super::camera::CameraModel;
-use super::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
-use super::light::{area_pdf, LightSource};
-use super::rng::{PassStreams, Sampler};
-use super::sampling::{power_heuristic, ROUND_BY_ADDING};
-use super::tiles::TileRect;
-use super::world::{ShapeRef, World};
-use super::Counters;
 use crate::geometry::{gamma, Ray, SurfaceHit};
+use crate::render::engine::tiles::TileRect;
+use crate::render::integrators::Counters;
+use crate::render::world::camera::CameraModel;
+use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
+use crate::render::world::light::LightSource;
+use crate::render::world::rng::{PassStreams, Sampler};
+use crate::render::world::sampling::{power_heuristic, ROUND_BY_ADDING};
+use crate::render::world::{ShapeRef, World};
 use crate::scene::{MaterialModel, Rgb};
 
 /// Bounces before Russian roulette may end a path (as in `path`).
-const ROULETTE_DEPTH: u32 = super::path::ROULETTE_DEPTH;
+const ROULETTE_DEPTH: u32 = crate::render::integrators::path::ROULETTE_DEPTH;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Kind {
@@ -321,9 +321,9 @@ impl PathLanes {
         for lane in (0..LANES).filter(|&i| glowing.test(i)) {
             let object = sphere[lane].object;
             let weight = match world.objects[object as usize].light {
-                Some(_) if !st.after_delta.test(lane) => power_heuristic(
+                Some(light) if !st.after_delta.test(lane) => power_heuristic(
                     st.last_pdf.lane(lane),
-                    pick_pdf * area_pdf(world, object, st.last_point.lane(lane), &hit(lane)),
+                    pick_pdf * world.lights[light as usize].pdf(st.last_point.lane(lane), &hit(lane)),
                 ),
                 _ => 1.0,
             };
@@ -457,7 +457,7 @@ impl PathLanes {
 fn one_by_one(world: &World, tile: &CameraTile, max_depth: u32, out: &mut [Rgb], counters: &mut Counters) {
     for (i, value) in out.iter_mut().enumerate() {
         let (ray, mut sampler) = tile.sample(i);
-        *value = super::path::radiance(world, &ray, max_depth, &mut sampler, counters);
+        *value = crate::render::integrators::path::radiance(world, &ray, max_depth, &mut sampler, counters);
     }
 }
 
@@ -770,7 +770,7 @@ impl LightLanes {
         for lane in (0..LANES).filter(|&i| others.test(i)) {
             let light = &world.lights[pick[lane]];
             let u = Vec2::new(u.0.lane(lane), u.1.lane(lane));
-            if let Some(sample) = light.sample(world, &hit(lane), u) {
+            if let Some(sample) = light.sample(&hit(lane), u) {
                 out.valid.set(lane, true);
                 out.delta.set(lane, light.is_delta());
                 out.wi.set_lane(lane, sample.wi);
@@ -933,7 +933,7 @@ fn offset_ray_origin(point: V8, error: F8, normal: V8, direction: V8) -> V8 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::camera::CameraModel;
+    use crate::render::world::camera::CameraModel;
 
     /// What a CPU without AVX2 renders: the scalar tracer's samples, the
     /// lanes' bit for bit (`tests/path_lanes.rs` holds the lanes to the

@@ -5,14 +5,15 @@
 
 use glam::Vec3;
 
-use super::kdtree::Neighbours;
-use super::maps::{estimate, PhotonMaps, QueryStats};
+use super::next_event::PathScope;
+use super::Counters;
 use crate::geometry::Ray;
-use crate::render::bsdf::{Bsdf, Transport};
-use crate::render::occluders::Occluders;
-use crate::render::rng::Sampler;
+use crate::render::integrators::photon_map::kdtree::Neighbours;
+use crate::render::integrators::photon_map::maps::{estimate, PhotonMaps, QueryStats};
+use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::rng::Sampler;
 use crate::render::world::{Hit, World};
-use crate::render::{Counters, PhotonSettings};
+use crate::render::PhotonSettings;
 use crate::scene::Rgb;
 
 /// Specular bounces a gather ray may follow before it must find a surface.
@@ -32,8 +33,8 @@ impl PhotonScratch {
 
 pub struct PhotonRenderer<'a> {
     pub world: &'a World,
-    /// What blocks the shadow rays of the path being traced.
-    pub occluders: Occluders<'a>,
+    /// The world as the path being traced sees it.
+    pub scope: PathScope<'a>,
     pub maps: &'a PhotonMaps,
     pub settings: &'a PhotonSettings,
     pub max_depth: u32,
@@ -41,7 +42,7 @@ pub struct PhotonRenderer<'a> {
 
 impl PhotonRenderer<'_> {
     fn k(&self) -> usize {
-        (self.settings.k_nearest as usize).max(super::maps::MIN_PHOTONS)
+        (self.settings.k_nearest as usize).max(crate::render::integrators::photon_map::maps::MIN_PHOTONS)
     }
 
     pub fn radiance(
@@ -171,7 +172,7 @@ impl PhotonRenderer<'_> {
         scratch: &mut PhotonScratch,
     ) -> Rgb {
         let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
-        let mut radiance = direct_light(self.occluders, hit, wo, facing, bsdf, sampler, counters);
+        let mut radiance = self.scope.every_light(hit, wo, facing, bsdf, sampler, counters);
         radiance +=
             estimate(&self.maps.caustic, point, facing, wo, bsdf, k, r, &mut scratch.neighbours, &mut scratch.queries);
         if global {
@@ -189,33 +190,4 @@ impl PhotonRenderer<'_> {
         }
         radiance
     }
-}
-
-/// Direct light by shadow rays, one sample of every light (less noise than
-/// one light per sample, and photon mapping's cost is elsewhere).
-pub fn direct_light(
-    occluders: Occluders,
-    hit: &Hit,
-    wo: Vec3,
-    facing: Vec3,
-    bsdf: &Bsdf,
-    sampler: &mut Sampler,
-    counters: &mut Counters,
-) -> Rgb {
-    let world = occluders.world();
-    let mut radiance = Rgb::ZERO;
-    for light in &world.lights {
-        let Some(sample) = light.sample(world, &hit.surface, sampler.next_2d()) else {
-            continue;
-        };
-        let f = bsdf.eval(wo, sample.wi, facing);
-        if f == Rgb::ZERO {
-            continue;
-        }
-        counters.rays += 1;
-        if !occluders.blocks(&sample) {
-            radiance += f * sample.value * sample.wi.dot(facing);
-        }
-    }
-    radiance
 }

@@ -2,105 +2,26 @@
 //! structure of arrays for the nearest-hit loop), materials and lights
 //! resolved to indices, disabled lights dropped.
 
+pub mod bsdf;
+pub mod camera;
+pub(crate) mod lanes;
+pub mod light;
+pub mod occluders;
+pub mod rng;
+pub mod sampling;
+pub mod shapes;
+pub mod spheres;
+
 use glam::Vec3;
 
-use super::camera::CameraModel;
-use super::light::LightSource;
-use super::occluders::Walls;
-use super::spheres::SphereLanes;
-use crate::geometry::{intersect_triangle, Frame, Ray, SurfaceHit, Triangle};
+use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
 use crate::geometry::{plane_hit, plane_t, sphere_hit};
 use crate::scene::{LightKind, MaterialModel, Rgb, Scene, Shape};
-
-/// Which flat array an object's shape lives in, and where.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ShapeRef {
-    Sphere(u32),
-    Plane(u32),
-    Triangle(u32),
-}
-
-#[derive(Clone, Copy, Debug)]
-pub struct ObjectInfo {
-    pub shape: ShapeRef,
-    pub material: u32,
-    /// Index into `World::lights` when the object is a sampled area light.
-    pub light: Option<u32>,
-}
-
-/// Spheres as parallel arrays: the hit loop reads only what it needs.
-#[derive(Clone, Debug, Default)]
-pub struct Spheres {
-    pub center_x: Vec<f32>,
-    pub center_y: Vec<f32>,
-    pub center_z: Vec<f32>,
-    pub radius: Vec<f32>,
-    pub object: Vec<u32>,
-    /// The same spheres four to a SIMD group, for the hit loops.
-    pub lanes: SphereLanes,
-}
-
-impl Spheres {
-    #[inline]
-    pub fn center(&self, i: usize) -> Vec3 {
-        Vec3::new(self.center_x[i], self.center_y[i], self.center_z[i])
-    }
-}
-
-#[derive(Clone, Copy, Debug)]
-pub struct PlaneShape {
-    pub normal: Vec3,
-    pub offset: f32,
-    pub object: u32,
-}
-
-/// The part of a sphere that can light the scene: a cap about `frame.z`
-/// (from the centre), `one_minus_cos` its 1 − cos θ: 2 for the whole sphere,
-/// 0 for none. Light sampling draws only the cap and MIS leaves the rest to
-/// BSDF sampling, so there a cap that is too small costs noise, not light;
-/// photons leave only from the cap, so it must hold all that can be seen.
-#[derive(Clone, Copy, Debug)]
-pub struct EmitterCap {
-    pub frame: Frame,
-    pub one_minus_cos: f32,
-    /// The sphere whose inside the cap was cut to, if any.
-    pub wall: Option<u32>,
-}
-
-impl EmitterCap {
-    pub const WHOLE: EmitterCap =
-        EmitterCap { frame: Frame { x: Vec3::X, y: Vec3::Y, z: Vec3::Z }, one_minus_cos: 2.0, wall: None };
-
-    /// The part of the sphere (`center`, `radius`) inside the sphere
-    /// (`other`, `other_radius`): |p − c_o| ≤ R_o on the first sphere ⇔
-    /// cos θ ≥ (r² + d² − R_o²)/(2 r d) about the axis toward c_o. In f64:
-    /// with smallpt's walls the terms are near 1e10 and differ by 1e8.
-    fn inside(center: Vec3, radius: f32, other: Vec3, other_radius: f32) -> Self {
-        let to_other = other.as_dvec3() - center.as_dvec3();
-        let (d, r, big) = (to_other.length(), radius as f64, other_radius as f64);
-        let (axis, cos_min) = if d > 0.0 {
-            ((to_other / d).as_vec3(), (r * r + d * d - big * big) / (2.0 * r * d))
-        } else {
-            // Concentric: all inside or nothing
-            (Vec3::Z, if r < big { -1.0 } else { 1.0 })
-        };
-        let one_minus_cos = (1.0 - cos_min).clamp(0.0, 2.0) as f32;
-        if one_minus_cos >= 2.0 {
-            return Self::WHOLE;
-        }
-        EmitterCap { frame: Frame::from_z(axis), one_minus_cos, wall: None }
-    }
-
-    pub fn is_whole(&self) -> bool {
-        self.one_minus_cos >= 2.0
-    }
-
-    /// Area of the cap on a sphere of `radius`.
-    #[inline]
-    pub fn area(&self, radius: f32) -> f32 {
-        2.0 * std::f32::consts::PI * radius * radius * self.one_minus_cos
-    }
-}
+use camera::CameraModel;
+use light::{Emitter, EmitterCap, LightSource};
+use occluders::{Occluders, Walls};
+pub use shapes::{ObjectInfo, PlaneShape, ShapeRef, Spheres};
+use spheres::SphereLanes;
 
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
@@ -123,8 +44,6 @@ pub struct World {
     /// excluded), or around what the camera sees once `cover` was called.
     pub bounds_center: Vec3,
     pub bounds_radius: f32,
-    /// Per sphere, the cap that emits toward the scene (see `emitting_cap`).
-    caps: Vec<EmitterCap>,
     /// Spheres and planes that shadow rays from inside may skip (see `Occluders`).
     pub(crate) walls: Walls,
     /// Per triangle, the first light triangle whose plane holds it, if any
@@ -146,7 +65,6 @@ impl World {
             ambient: scene.ambient,
             bounds_center: Vec3::ZERO,
             bounds_radius: 0.0,
-            caps: Vec::new(),
             walls: Walls::default(),
             light_plane: Vec::new(),
         };
@@ -218,17 +136,26 @@ impl World {
                     ShapeRef::Plane(_) => false,
                 };
                 if sampled && radiance.max_element() > 0.0 {
+                    let emitter = match info.shape {
+                        ShapeRef::Sphere(i) => Emitter::Sphere {
+                            sphere: i,
+                            center: world.spheres.center(i as usize),
+                            radius: world.spheres.radius[i as usize],
+                            cap: EmitterCap::WHOLE,
+                        },
+                        ShapeRef::Triangle(t) => {
+                            Emitter::Triangle { triangle: t, shape: world.triangles[t as usize].0 }
+                        }
+                        ShapeRef::Plane(_) => continue,
+                    };
                     world.objects[index].light = Some(world.lights.len() as u32);
-                    world.lights.push(LightSource::Area { object: index as u32, radiance });
+                    world.lights.push(LightSource::Area { object: index as u32, radiance, emitter });
                 }
             }
         }
         let light_triangles: Vec<u32> = (world.lights.iter())
             .filter_map(|light| match light {
-                LightSource::Area { object, .. } => match world.objects[*object as usize].shape {
-                    ShapeRef::Triangle(t) => Some(t),
-                    _ => None,
-                },
+                LightSource::Area { emitter: Emitter::Triangle { triangle, .. }, .. } => Some(*triangle),
                 _ => None,
             })
             .collect();
@@ -238,7 +165,7 @@ impl World {
                 light_triangles.iter().copied().find(holds).unwrap_or(u32::MAX)
             })
             .collect();
-        world.caps = world.emitter_caps(None);
+        world.fit_caps(None);
         world
     }
 
@@ -280,6 +207,14 @@ impl World {
             ShapeRef::Triangle(i) => (triangle_hit?, self.triangles[i as usize].1),
         };
         Some(Hit { surface, object, material: self.objects[object as usize].material })
+    }
+
+    /// What can block the shadow rays of a path whose camera ray starts at
+    /// `origin` (see `Occluders`).
+    #[inline]
+    pub fn occluders(&self, origin: Vec3) -> Occluders<'_> {
+        let s = self;
+        Occluders::for_path(&s.walls, &s.spheres.lanes, &s.planes, &s.triangles, &s.light_plane, origin)
     }
 
     /// Whether anything lies on the ray in (0, t_max): shadow rays stop at the
@@ -345,15 +280,29 @@ impl World {
             self.bounds_radius = (hi - lo).length() * 0.75;
         }
         let eye = camera.central_origin();
-        self.caps = self.emitter_caps(Some(eye));
-        self.walls = Walls::find(self, eye);
+        self.fit_caps(Some(eye));
+        let opaque = |object: u32| {
+            let material = &self.materials[self.objects[object as usize].material as usize];
+            !matches!(material, MaterialModel::Glass { .. } | MaterialModel::Emissive { .. })
+        };
+        self.walls = Walls::find(&self.spheres, &self.planes, opaque, &self.lights, eye);
     }
 
     /// The part of sphere `sphere` that lights the scene, when it is an
     /// emitter (the whole sphere otherwise).
-    #[inline]
     pub fn emitting_cap(&self, sphere: usize) -> EmitterCap {
-        self.caps.get(sphere).copied().unwrap_or(EmitterCap::WHOLE)
+        let on_it = |light: &&LightSource| matches!(light, LightSource::Area { emitter: Emitter::Sphere { sphere: s, .. }, .. } if *s as usize == sphere);
+        self.lights.iter().find(on_it).and_then(LightSource::cap).unwrap_or(EmitterCap::WHOLE)
+    }
+
+    /// Give each sphere light the cap it emits from (`emitter_caps`).
+    fn fit_caps(&mut self, eye: Option<Vec3>) {
+        let caps = self.emitter_caps(eye);
+        for light in &mut self.lights {
+            if let LightSource::Area { emitter: Emitter::Sphere { sphere, cap, .. }, .. } = light {
+                *cap = caps[*sphere as usize];
+            }
+        }
     }
 
     /// Each emissive sphere's cap:

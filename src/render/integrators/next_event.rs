@@ -1,0 +1,111 @@
+//! Next-event estimation, written once: a light sample toward a shading
+//! point, what the integrator makes of it, the shadow ray. Each algorithm
+//! chooses its policy on top: path tracing one light with MIS, photon
+//! mapping and SPPM every light, Whitted every light through the thesis'
+//! local models.
+
+use glam::{Vec2, Vec3};
+
+use super::Counters;
+use crate::render::world::bsdf::Bsdf;
+use crate::render::world::light::{LightSample, LightSource};
+use crate::render::world::occluders::Occluders;
+use crate::render::world::rng::Sampler;
+use crate::render::world::sampling::power_heuristic;
+use crate::render::world::{Hit, World};
+use crate::scene::Rgb;
+
+/// The world as one path sees it: its shapes, and what can block its
+/// shadow rays (which depends on where the path started).
+#[derive(Clone, Copy)]
+pub struct PathScope<'w> {
+    pub world: &'w World,
+    pub occluders: Occluders<'w>,
+}
+
+impl<'w> PathScope<'w> {
+    /// For a path whose camera ray starts at `origin`.
+    #[inline]
+    pub fn new(world: &'w World, origin: Vec3) -> Self {
+        Self { world, occluders: world.occluders(origin) }
+    }
+
+    /// One sample of `light` at `hit` (drawn from `u`): what `shade` makes of
+    /// it, when `shade` finds it can matter (Some) and nothing blocks it. The
+    /// shadow ray is counted only when it is traced.
+    #[inline]
+    pub fn light_sample<T>(
+        &self,
+        light: &LightSource,
+        hit: &Hit,
+        u: Vec2,
+        counters: &mut Counters,
+        shade: impl FnOnce(&LightSample) -> Option<T>,
+    ) -> Option<(LightSample, T)> {
+        let sample = light.sample(&hit.surface, u)?;
+        let value = shade(&sample)?;
+        counters.rays += 1;
+        (!self.occluders.blocks(&sample)).then_some((sample, value))
+    }
+
+    /// Direct light from one light chosen uniformly, weighted against BSDF
+    /// sampling by the power heuristic (delta lights at full weight), times
+    /// `throughput`: path tracing's estimate.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn one_light(
+        &self,
+        hit: &Hit,
+        wo: Vec3,
+        facing: Vec3,
+        bsdf: &Bsdf,
+        throughput: Rgb,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+    ) -> Rgb {
+        let lights = &self.world.lights;
+        let count = lights.len();
+        if count == 0 {
+            return Rgb::ZERO;
+        }
+        // One light needs no draw to choose it
+        let pick = match count {
+            1 => 0,
+            _ => ((sampler.next_f32() * count as f32) as usize).min(count - 1),
+        };
+        let pick_pdf = 1.0 / count as f32;
+        let light = &lights[pick];
+        let shade = |sample: &LightSample| Some(bsdf.eval(wo, sample.wi, facing)).filter(|f| *f != Rgb::ZERO);
+        let Some((sample, f)) = self.light_sample(light, hit, sampler.next_2d(), counters, shade) else {
+            return Rgb::ZERO;
+        };
+        let weight = if light.is_delta() {
+            1.0
+        } else {
+            power_heuristic(pick_pdf * sample.pdf, bsdf.pdf(wo, sample.wi, facing))
+        };
+        throughput * f * sample.value * (sample.wi.dot(facing) * weight / pick_pdf)
+    }
+
+    /// Direct light from one sample of every light, unweighted: photon
+    /// mapping's and SPPM's estimate (less noise than one light a sample, and
+    /// their cost is elsewhere).
+    pub fn every_light(
+        &self,
+        hit: &Hit,
+        wo: Vec3,
+        facing: Vec3,
+        bsdf: &Bsdf,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+    ) -> Rgb {
+        let mut radiance = Rgb::ZERO;
+        for light in &self.world.lights {
+            let shade = |sample: &LightSample| Some(bsdf.eval(wo, sample.wi, facing)).filter(|f| *f != Rgb::ZERO);
+            if let Some((sample, f)) = self.light_sample(light, hit, sampler.next_2d(), counters, shade) {
+                radiance += f * sample.value * sample.wi.dot(facing);
+            }
+        }
+        radiance
+    }
+}

@@ -1,0 +1,13 @@
+//! The photon map: photons traced from the lights into Jensen's global and
+//! caustic maps on our own kd-tree, their radiance estimate, and map files.
+
+pub mod emit;
+pub mod file;
+pub mod kdtree;
+pub mod maps;
+pub mod record;
+pub mod trace;
+
+pub use kdtree::{Neighbours, PhotonKdTree};
+pub use maps::{PhotonMapStats, PhotonMaps, QueryStats};
+pub use record::Photon;

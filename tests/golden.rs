@@ -1,0 +1,66 @@
+//! Golden images: a hash of every preset rendered by every algorithm at
+//! 64×48, 4 spp, a fixed seed. A refactor must leave every hash as it was;
+//! an intended change of an image is its own commit, which says why and
+//! updates the hash here. (The hashes are of this machine's float
+//! arithmetic: x86-64, and the same on any thread count.)
+
+use std::sync::Arc;
+
+use gi_studio::render::{render_blocking, Algorithm, LinearImage, RenderJob, RenderSettings};
+use gi_studio::scene::presets;
+
+/// (preset, algorithm, FNV-1a of the image's f32 bits).
+const GOLDEN: &[(&str, &str, u64)] = &[
+    ("cornell", "whitted", 0x80aa3c0ec2f92365),
+    ("cornell", "path", 0xe833e0642c370660),
+    ("cornell", "photon", 0xa6bf1191bf239d81),
+    ("cornell", "sppm", 0x9ff35c03be1f7b45),
+    ("smallpt", "whitted", 0x6bb39f84cb1d64e5),
+    ("smallpt", "path", 0x8b9b8d2ea6e8852d),
+    ("smallpt", "photon", 0xec124d9b5070a158),
+    ("smallpt", "sppm", 0x4e36cee3f7b4d1e3),
+    ("thesis", "whitted", 0xf5a083af67f2ead7),
+    ("thesis", "path", 0xbb216807403aa573),
+    ("thesis", "photon", 0xade1c0ea041e611a),
+    ("thesis", "sppm", 0xf01bf5ec4e645aa2),
+    ("lights", "whitted", 0x0cbf44367ab62662),
+    ("lights", "path", 0x90d7148184658b0f),
+    ("lights", "photon", 0x71efe51313becae6),
+    ("lights", "sppm", 0xcf2fd0515198e408),
+    ("caustics", "whitted", 0xb91b2d20a3a39a19),
+    ("caustics", "path", 0x254a1bdcdc40f3eb),
+    ("caustics", "photon", 0x4cd0fde0f1043e21),
+    ("caustics", "sppm", 0x61a9d04d5163d909),
+];
+
+pub fn image_hash(image: &LinearImage) -> u64 {
+    let words = [image.width, image.height].into_iter().chain(image.pixels.iter().flatten().map(|c| c.to_bits()));
+    words.flat_map(u32::to_le_bytes).fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
+}
+
+fn golden_render(preset: &str, algorithm: Algorithm) -> LinearImage {
+    let scene = presets::preset(preset).unwrap().unwrap();
+    let mut settings = RenderSettings {
+        width: 64,
+        height: 48,
+        samples_per_pixel: Some(4),
+        seed: 20_261_201,
+        ..RenderSettings::for_algorithm(algorithm)
+    };
+    settings.photon.global_photons = 20_000;
+    settings.photon.caustic_photons = 20_000;
+    settings.photon.sppm_photons_per_pass = 20_000;
+    render_blocking(&RenderJob::new(Arc::new(scene), settings)).unwrap().0
+}
+
+#[test]
+fn every_preset_and_algorithm_renders_its_golden_image() {
+    let mut changed = Vec::new();
+    for &(preset, algorithm, expected) in GOLDEN {
+        let found = image_hash(&golden_render(preset, algorithm.parse().unwrap()));
+        if found != expected {
+            changed.push(format!("    (\"{preset}\", \"{algorithm}\", {found:#018x}),"));
+        }
+    }
+    assert!(changed.is_empty(), "images changed; if intended, commit them on their own with:\n{}", changed.join("\n"));
+}
