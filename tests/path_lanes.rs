@@ -2,11 +2,12 @@
 //! samples give the same radiance, bit for bit, whatever the lane a path
 //! lands in and however long its neighbours live.
 
-use gi_studio::render::engine::tiles::TileRect;
 use gi_studio::render::integrators::path;
-use gi_studio::render::integrators::path_lanes::{CameraTile, PathLanes};
+use gi_studio::render::integrators::path_lanes::PathLanes;
 use gi_studio::render::integrators::Counters;
 use gi_studio::render::world::camera::CameraModel;
+use gi_studio::render::world::camera::CameraTile;
+use gi_studio::render::world::camera::TileRect;
 use gi_studio::render::world::rng::PassStreams;
 use gi_studio::render::world::World;
 use gi_studio::scene::{presets, Attenuation, Light, LightKind, MaterialModel, Rgb, Scene};

@@ -9,9 +9,9 @@ use std::time::Duration;
 use eframe::egui;
 
 use crate::analysis::metrics::{rel_mse, RelMseOptions};
-use crate::render::engine::tiles::TileRect;
 use crate::render::image::tonemap_srgb8;
 use crate::render::integrators::photon_map::PhotonMapStats;
+use crate::render::world::camera::TileRect;
 use crate::render::{Algorithm, LinearImage, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
 use crate::scene::Scene;
 

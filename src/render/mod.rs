@@ -6,15 +6,17 @@
 //! - `engine`: jobs, passes over tiles in parallel, the film, sessions and
 //!   their events. It knows nothing about any user interface.
 //!
-//! `settings` (what to render) and `image` (what comes out) are leaves
-//! every layer may use.
+//! `settings` (what to render), `film` (what passes add into) and `image`
+//! (what comes out) are leaves every layer may use.
 
 pub mod engine;
+pub mod film;
 pub mod image;
 pub mod integrators;
 pub mod settings;
 pub mod world;
 
-pub use engine::{render_blocking, PassStats, PhotonPassStats, RenderEvent, RenderJob, RenderSession, TileUpdate};
+pub use engine::{render_blocking, PassStats, RenderEvent, RenderJob, RenderSession, TileUpdate};
 pub use image::LinearImage;
+pub use integrators::PhotonPassStats;
 pub use settings::{Algorithm, PhotonSettings, RenderSettings};

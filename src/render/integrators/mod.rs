@@ -1,4 +1,8 @@
-//! The light-transport algorithms, one file each, and what they share.
+//! The light-transport algorithms: one closed enum, prepared once per job
+//! (photon maps traced, lanes compiled), one file each, answering the same
+//! questions — render a pass into the film, show a coarse preview, say what
+//! a tile looks like now. What they share is written once: next-event
+//! estimation (`next_event`), BSDFs, occlusion and the lanes (`world`).
 
 pub mod next_event;
 pub mod path;
@@ -8,10 +12,249 @@ pub mod photon_map;
 pub mod sppm;
 pub mod whitted;
 
+use std::sync::Arc;
+use std::time::Duration;
+
+use rayon::prelude::*;
+
+use crate::render::film::{Film, FilmTile};
+use crate::render::settings::{Algorithm, RenderSettings};
+use crate::render::world::camera::{CameraModel, CameraTile, TileRect};
+use crate::render::world::rng::PassStreams;
+use crate::render::world::World;
+use crate::scene::Rgb;
+use photon_map::{PhotonMapStats, PhotonMaps, QueryStats};
+
 /// Work counted per tile and summed per pass.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Counters {
     pub rays: u64,
     pub non_finite: u64,
-    pub queries: photon_map::QueryStats,
+    pub queries: QueryStats,
+}
+
+impl Counters {
+    pub fn add(&mut self, other: &Counters) {
+        self.rays += other.rays;
+        self.non_finite += other.non_finite;
+        self.queries.add(&other.queries);
+    }
+}
+
+/// Photon work of one pass (photon mapping's queries, SPPM's photons).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhotonPassStats {
+    /// k-NN queries made while rendering the pass.
+    pub queries: QueryStats,
+    /// SPPM: photons traced and stored this pass, and the time it took.
+    pub photons_traced: u64,
+    pub photons_stored: u64,
+    pub trace_time: Duration,
+    /// SPPM: mean gather radius over pixels after the pass.
+    pub mean_radius: f32,
+}
+
+/// What one pass did.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PassReport {
+    pub counters: Counters,
+    pub photon: PhotonPassStats,
+}
+
+/// Everything a pass reads: shared, immutable, built once per job.
+pub struct Stage<'a> {
+    pub world: &'a World,
+    pub camera: &'a CameraModel,
+    pub settings: &'a RenderSettings,
+}
+
+impl Stage<'_> {
+    /// The streams of sample `sample` of every pixel.
+    pub fn streams(&self, sample: u64) -> PassStreams {
+        PassStreams::new(sample, self.settings.seed)
+    }
+
+    /// A sample as it may enter the film: finite, not negative, clamped only
+    /// if asked; a NaN or infinity is counted and dropped.
+    #[inline]
+    pub fn accept(&self, value: Rgb, counters: &mut Counters) -> Option<Rgb> {
+        if !value.is_finite() {
+            counters.non_finite += 1;
+            return None;
+        }
+        let value = value.max(Rgb::ZERO);
+        let clamp = self.settings.firefly_clamp;
+        Some(if clamp > 0.0 { value.min(Rgb::splat(clamp)) } else { value })
+    }
+}
+
+/// What a pass tells its driver, and asks it.
+pub trait PassObserver: Sync {
+    /// Whether the job is still wanted: checked before every tile and every
+    /// chunk of photons, so a restart never waits for a pass to end.
+    fn is_current(&self) -> bool;
+    /// Whether the driver wants each tile's estimate after each pass.
+    fn wants_tiles(&self) -> bool;
+    fn tile(&self, rect: TileRect, pixels: Vec<[f32; 3]>);
+}
+
+/// Sample index used for the coarse preview, outside any real pass's range.
+const PREVIEW_SAMPLE: u64 = u64::MAX;
+const PREVIEW_BLOCK: u32 = 8;
+
+pub enum Integrator {
+    Whitted(whitted::Whitted),
+    Path(path::PathTracer),
+    Photon(photon::PhotonMapping),
+    Sppm(sppm::Sppm),
+}
+
+impl Integrator {
+    /// The algorithm of `stage.settings`, prepared: `maps` are photon maps
+    /// made earlier for this scene and settings (traced afresh when absent).
+    /// None if the job was abandoned while preparing.
+    pub fn prepare(
+        stage: &Stage,
+        film: &Film,
+        visible_radius: f32,
+        maps: Option<Arc<PhotonMaps>>,
+        observer: &dyn PassObserver,
+    ) -> Option<Self> {
+        let settings = stage.settings;
+        Some(match settings.algorithm {
+            Algorithm::Whitted => Integrator::Whitted(whitted::Whitted { max_depth: settings.max_depth.max(1) }),
+            Algorithm::Path => Integrator::Path(path::PathTracer::new(stage.world, settings.max_depth)),
+            Algorithm::Photon => {
+                let maps = match maps {
+                    Some(maps) => maps,
+                    None => Arc::new(PhotonMaps::build(
+                        stage.world,
+                        &settings.photon,
+                        settings.seed,
+                        settings.max_depth,
+                        visible_radius,
+                    )),
+                };
+                if !observer.is_current() {
+                    return None;
+                }
+                Integrator::Photon(photon::PhotonMapping::new(maps, settings))
+            }
+            Algorithm::Sppm => Integrator::Sppm(sppm::Sppm::new(film, settings, visible_radius)),
+        })
+    }
+
+    /// The photon maps' statistics, for photon mapping.
+    pub fn photon_maps(&self) -> Option<PhotonMapStats> {
+        match self {
+            Integrator::Photon(p) => Some(p.maps.stats),
+            _ => None,
+        }
+    }
+
+    /// Render pass `pass` into `film`. None if the job was abandoned.
+    pub fn pass(
+        &mut self,
+        stage: &Stage,
+        film: &mut Film,
+        pass: u32,
+        observer: &dyn PassObserver,
+    ) -> Option<PassReport> {
+        match self {
+            Integrator::Sppm(sppm) => sppm.pass(stage, film, pass, observer),
+            _ => self.sample_pass(stage, film, pass, observer),
+        }
+    }
+
+    /// What tile `tile` of `film` shows now.
+    pub fn tile_pixels(&self, film: &Film, tile: usize) -> Vec<[f32; 3]> {
+        match self {
+            Integrator::Sppm(sppm) => sppm.tile_pixels(film, tile),
+            _ => film.tiles[tile].mean(),
+        }
+    }
+
+    /// One pass of independent samples per pixel: every tile in parallel,
+    /// each sample accepted (`Stage::accept`) and added to its pixel.
+    fn sample_pass(
+        &self,
+        stage: &Stage,
+        film: &mut Film,
+        pass: u32,
+        observer: &dyn PassObserver,
+    ) -> Option<PassReport> {
+        let streams = stage.streams(pass as u64);
+        let per_tile: Vec<Counters> = film
+            .tiles
+            .par_iter_mut()
+            .map(|tile| {
+                let mut counters = Counters::default();
+                if observer.is_current() {
+                    self.render_tile(stage, tile, streams, &mut counters);
+                    if observer.wants_tiles() {
+                        observer.tile(tile.rect, tile.mean());
+                    }
+                }
+                counters
+            })
+            .collect();
+        if !observer.is_current() {
+            return None;
+        }
+        let mut report = PassReport::default();
+        for counters in &per_tile {
+            report.counters.add(counters);
+        }
+        report.photon.queries = report.counters.queries;
+        Some(report)
+    }
+
+    fn render_tile(&self, stage: &Stage, tile: &mut FilmTile, streams: PassStreams, counters: &mut Counters) {
+        let camera_tile = CameraTile { camera: stage.camera, rect: tile.rect, streams };
+        let mut values = vec![Rgb::ZERO; tile.sums.len()];
+        match self {
+            Integrator::Whitted(whitted) => whitted.render_tile(stage, &camera_tile, &mut values, counters),
+            Integrator::Path(path) => path.render_tile(stage, &camera_tile, &mut values, counters),
+            Integrator::Photon(photon) => photon.render_tile(stage, &camera_tile, &mut values, counters),
+            Integrator::Sppm(_) => unreachable!("SPPM renders its own passes"),
+        }
+        for (i, value) in values.into_iter().enumerate() {
+            tile.add(i, stage.accept(value, counters).unwrap_or(Rgb::ZERO));
+        }
+        tile.samples += 1;
+    }
+
+    /// One sample per block of `rect`, copied over the block: something to
+    /// show before the first pass.
+    pub fn preview_tile(&self, stage: &Stage, rect: TileRect) -> Vec<[f32; 3]> {
+        let mut pixels = vec![[0.0; 3]; rect.pixels()];
+        let mut counters = Counters::default();
+        let streams = stage.streams(PREVIEW_SAMPLE);
+        let mut scratch = None;
+        for by in (0..rect.height).step_by(PREVIEW_BLOCK as usize) {
+            for bx in (0..rect.width).step_by(PREVIEW_BLOCK as usize) {
+                let (w, h) = (PREVIEW_BLOCK.min(rect.width - bx), PREVIEW_BLOCK.min(rect.height - by));
+                let (x, y) = (rect.x + bx + w / 2, rect.y + by + h / 2);
+                let (ray, mut sampler) = stage.camera.sample_ray(x, y, streams);
+                let sampler = &mut sampler;
+                let value = match self {
+                    Integrator::Whitted(whitted) => whitted.radiance(stage.world, &ray, sampler, &mut counters),
+                    Integrator::Path(path) => path.radiance(stage.world, &ray, sampler, &mut counters),
+                    Integrator::Photon(photon) => {
+                        let scratch = scratch.get_or_insert_with(|| photon.scratch());
+                        photon.radiance(stage.world, &ray, sampler, &mut counters, scratch)
+                    }
+                    // SPPM has no estimate before its first pass: show direct light
+                    Integrator::Sppm(sppm) => sppm.direct(stage.world, &ray, sampler, &mut counters),
+                };
+                let value = stage.accept(value, &mut counters).unwrap_or(Rgb::ZERO);
+                for y in by..by + h {
+                    for x in bx..bx + w {
+                        pixels[(y * rect.width + x) as usize] = value.to_array();
+                    }
+                }
+            }
+        }
+        pixels
+    }
 }

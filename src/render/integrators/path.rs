@@ -3,9 +3,12 @@
 //! sampling for area lights, Russian roulette.
 
 use super::next_event::PathScope;
+use super::path_lanes::PathLanes;
 use super::Counters;
+use super::Stage;
 use crate::geometry::Ray;
 use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::camera::CameraTile;
 use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::power_heuristic;
 use crate::render::world::World;
@@ -13,6 +16,35 @@ use crate::scene::Rgb;
 
 /// Bounces before Russian roulette may end a path.
 pub(crate) const ROULETTE_DEPTH: u32 = 3;
+
+/// Path tracing: eight paths at a time where the world is made of spheres
+/// (`PathLanes`, the same samples bit for bit), one at a time elsewhere.
+pub struct PathTracer {
+    max_depth: u32,
+    lanes: Option<PathLanes>,
+}
+
+impl PathTracer {
+    pub fn new(world: &World, max_depth: u32) -> Self {
+        Self { max_depth, lanes: PathLanes::new(world) }
+    }
+
+    #[inline]
+    pub fn radiance(&self, world: &World, ray: &Ray, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
+        radiance(world, ray, self.max_depth, sampler, counters)
+    }
+
+    /// One sample of every pixel of `tile`, into `out`.
+    pub fn render_tile(&self, stage: &Stage, tile: &CameraTile, out: &mut [Rgb], counters: &mut Counters) {
+        if let Some(lanes) = &self.lanes {
+            return lanes.radiance(stage.world, tile, self.max_depth, out, counters);
+        }
+        for (i, value) in out.iter_mut().enumerate() {
+            let (ray, mut sampler) = tile.sample(i);
+            *value = self.radiance(stage.world, &ray, &mut sampler, counters);
+        }
+    }
+}
 
 pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
     let scope = PathScope::new(world, ray.origin);

@@ -14,12 +14,11 @@ use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_4, PI};
 use glam::{Vec2, Vec3};
 
 use crate::geometry::{gamma, Ray, SurfaceHit};
-use crate::render::engine::tiles::TileRect;
 use crate::render::integrators::Counters;
-use crate::render::world::camera::CameraModel;
+use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
 use crate::render::world::light::LightSource;
-use crate::render::world::rng::{PassStreams, Sampler};
+use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::{power_heuristic, ROUND_BY_ADDING};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::{MaterialModel, Rgb};
@@ -458,31 +457,6 @@ fn one_by_one(world: &World, tile: &CameraTile, max_depth: u32, out: &mut [Rgb],
     for (i, value) in out.iter_mut().enumerate() {
         let (ray, mut sampler) = tile.sample(i);
         *value = crate::render::integrators::path::radiance(world, &ray, max_depth, &mut sampler, counters);
-    }
-}
-
-/// The camera samples of one pass over a tile: pixel (x, y) of `rect`, row
-/// by row, as `CameraModel::sample_ray` draws them.
-#[derive(Clone, Copy, Debug)]
-pub struct CameraTile<'a> {
-    pub camera: &'a CameraModel,
-    pub rect: TileRect,
-    pub streams: PassStreams,
-}
-
-impl CameraTile<'_> {
-    pub fn len(&self) -> usize {
-        (self.rect.width * self.rect.height) as usize
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Sample `i`'s ray and the stream it leaves, drawn one at a time.
-    pub fn sample(&self, i: usize) -> (Ray, Sampler) {
-        let (column, row) = (i as u32 % self.rect.width, i as u32 / self.rect.width);
-        self.camera.sample_ray(self.rect.x + column, self.rect.y + row, self.streams)
     }
 }
 
@@ -933,7 +907,8 @@ fn offset_ray_origin(point: V8, error: F8, normal: V8, direction: V8) -> V8 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::world::camera::CameraModel;
+    use crate::render::world::camera::{CameraModel, TileRect};
+    use crate::render::world::rng::PassStreams;
 
     /// What a CPU without AVX2 renders: the scalar tracer's samples, the
     /// lanes' bit for bit (`tests/path_lanes.rs` holds the lanes to the

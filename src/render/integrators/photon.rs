@@ -3,17 +3,20 @@
 //! from the caustic map, indirect light from the global map — directly or
 //! through a final gather of one bounce.
 
+use std::sync::Arc;
+
 use glam::Vec3;
 
 use super::next_event::PathScope;
-use super::Counters;
+use super::photon_map::kdtree::Neighbours;
+use super::photon_map::maps::{estimate, PhotonMaps, QueryStats};
+use super::{Counters, Stage};
 use crate::geometry::Ray;
-use crate::render::integrators::photon_map::kdtree::Neighbours;
-use crate::render::integrators::photon_map::maps::{estimate, PhotonMaps, QueryStats};
+use crate::render::settings::{PhotonSettings, RenderSettings};
 use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::camera::CameraTile;
 use crate::render::world::rng::Sampler;
 use crate::render::world::{Hit, World};
-use crate::render::PhotonSettings;
 use crate::scene::Rgb;
 
 /// Specular bounces a gather ray may follow before it must find a surface.
@@ -31,13 +34,59 @@ impl PhotonScratch {
     }
 }
 
-pub struct PhotonRenderer<'a> {
-    pub world: &'a World,
+/// Photon mapping with the maps of one job.
+pub struct PhotonMapping {
+    pub maps: Arc<PhotonMaps>,
+    settings: PhotonSettings,
+    max_depth: u32,
+}
+
+impl PhotonMapping {
+    pub fn new(maps: Arc<PhotonMaps>, settings: &RenderSettings) -> Self {
+        Self { maps, settings: settings.photon.clone(), max_depth: settings.max_depth }
+    }
+
+    pub fn scratch(&self) -> PhotonScratch {
+        PhotonScratch::new((self.settings.k_nearest as usize).max(super::photon_map::maps::MIN_PHOTONS))
+    }
+
+    #[inline]
+    pub fn radiance(
+        &self,
+        world: &World,
+        ray: &Ray,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        scratch: &mut PhotonScratch,
+    ) -> Rgb {
+        let renderer = PhotonRenderer {
+            world,
+            scope: PathScope::new(world, ray.origin),
+            maps: &self.maps,
+            settings: &self.settings,
+            max_depth: self.max_depth,
+        };
+        renderer.radiance(ray, sampler, counters, scratch)
+    }
+
+    /// One sample of every pixel of `tile`, into `out`.
+    pub fn render_tile(&self, stage: &Stage, tile: &CameraTile, out: &mut [Rgb], counters: &mut Counters) {
+        let mut scratch = self.scratch();
+        for (i, value) in out.iter_mut().enumerate() {
+            let (ray, mut sampler) = tile.sample(i);
+            *value = self.radiance(stage.world, &ray, &mut sampler, counters, &mut scratch);
+        }
+        counters.queries.add(&scratch.queries);
+    }
+}
+
+struct PhotonRenderer<'a> {
+    world: &'a World,
     /// The world as the path being traced sees it.
-    pub scope: PathScope<'a>,
-    pub maps: &'a PhotonMaps,
-    pub settings: &'a PhotonSettings,
-    pub max_depth: u32,
+    scope: PathScope<'a>,
+    maps: &'a PhotonMaps,
+    settings: &'a PhotonSettings,
+    max_depth: u32,
 }
 
 impl PhotonRenderer<'_> {

@@ -7,17 +7,135 @@
 //! only light after its first bounce.
 
 use std::f32::consts::PI;
+use std::time::Instant;
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::next_event::PathScope;
+use super::photon_map::kdtree::PhotonKdTree;
+use super::photon_map::trace::{trace_photons, MapKind};
+use super::{Counters, PassObserver, PassReport, Stage};
 use crate::geometry::Ray;
-use crate::render::integrators::photon_map::kdtree::PhotonKdTree;
-use crate::render::integrators::Counters;
+use crate::render::film::Film;
+use crate::render::settings::RenderSettings;
 use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::camera::CameraTile;
 use crate::render::world::rng::Sampler;
 use crate::render::world::World;
 use crate::scene::Rgb;
+
+/// SPPM over a film: every pixel's progressive state, tile by tile as the
+/// film's tiles are.
+pub struct Sppm {
+    pixels: Vec<Vec<SppmPixel>>,
+    initial_radius: f32,
+    photons_per_pass: u64,
+    alpha: f32,
+    max_depth: u32,
+    seed: u64,
+}
+
+impl Sppm {
+    /// The starting radius is the settings', or 2% of what the camera sees.
+    pub fn new(film: &Film, settings: &RenderSettings, visible_radius: f32) -> Self {
+        let p = &settings.photon;
+        let initial_radius =
+            if p.sppm_initial_radius > 0.0 { p.sppm_initial_radius } else { (visible_radius * 0.02).max(1e-6) };
+        Self {
+            pixels: film.tiles.iter().map(|t| vec![SppmPixel::default(); t.sums.len()]).collect(),
+            initial_radius,
+            photons_per_pass: p.sppm_photons_per_pass as u64,
+            alpha: p.sppm_alpha,
+            max_depth: settings.max_depth,
+            seed: settings.seed,
+        }
+    }
+
+    /// Light found along a camera ray up to its visible point (the preview).
+    pub fn direct(&self, world: &World, ray: &Ray, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
+        camera_pass(world, ray, self.max_depth, sampler, counters).0
+    }
+
+    /// What tile `tile` shows after the passes so far.
+    pub fn tile_pixels(&self, film: &Film, tile: usize) -> Vec<[f32; 3]> {
+        let passes = film.tiles[tile].samples;
+        self.pixels[tile].iter().map(|p| p.value(passes).to_array()).collect()
+    }
+
+    /// One pass: visible points for every pixel, this pass's photons, then
+    /// each pixel's update. None if the job was abandoned.
+    pub fn pass(
+        &mut self,
+        stage: &Stage,
+        film: &mut Film,
+        pass: u32,
+        observer: &dyn PassObserver,
+    ) -> Option<PassReport> {
+        let streams = stage.streams(pass as u64);
+        let initial_radius = self.initial_radius;
+        let max_depth = self.max_depth;
+        let mut report = PassReport::default();
+        let per_tile: Vec<Counters> = (film.tiles.par_iter())
+            .zip(self.pixels.par_iter_mut())
+            .map(|(tile, pixels)| {
+                let mut counters = Counters::default();
+                if !observer.is_current() {
+                    return counters;
+                }
+                let camera_tile = CameraTile { camera: stage.camera, rect: tile.rect, streams };
+                for (i, pixel) in pixels.iter_mut().enumerate() {
+                    let (ray, mut sampler) = camera_tile.sample(i);
+                    let (direct, visible) = camera_pass(stage.world, &ray, max_depth, &mut sampler, &mut counters);
+                    pixel.direct += stage.accept(direct, &mut counters).unwrap_or(Rgb::ZERO);
+                    pixel.visible = visible;
+                    if pixel.radius == 0.0 {
+                        pixel.radius = initial_radius;
+                    }
+                }
+                counters
+            })
+            .collect();
+        if !observer.is_current() {
+            return None;
+        }
+        for counters in &per_tile {
+            report.counters.add(counters);
+        }
+        let trace_start = Instant::now();
+        let count = self.photons_per_pass;
+        let photons = trace_photons(stage.world, MapKind::Indirect, count, pass as u64, self.seed, max_depth);
+        report.photon.photons_traced = count;
+        report.photon.photons_stored = photons.len() as u64;
+        let tree = PhotonKdTree::build(photons);
+        report.photon.trace_time = trace_start.elapsed();
+        if !observer.is_current() {
+            return None;
+        }
+        let alpha = self.alpha;
+        let radii: Vec<(f64, usize)> = (film.tiles.par_iter_mut())
+            .zip(self.pixels.par_iter_mut())
+            .map(|(tile, pixels)| {
+                if !observer.is_current() {
+                    return (0.0, 0);
+                }
+                let mut sum = 0.0;
+                for pixel in pixels.iter_mut() {
+                    pixel.gather(&tree, alpha);
+                    sum += pixel.radius as f64;
+                }
+                tile.samples += 1;
+                if observer.wants_tiles() {
+                    observer.tile(tile.rect, pixels.iter().map(|p| p.value(tile.samples).to_array()).collect());
+                }
+                (sum, pixels.len())
+            })
+            .collect();
+        let (sum, count) = radii.iter().fold((0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        report.photon.mean_radius = (sum / count.max(1) as f64) as f32;
+        Some(report)
+    }
+}
 
 #[derive(Clone, Copy, Debug)]
 pub struct VisiblePoint {

@@ -11,9 +11,11 @@ use std::f32::consts::FRAC_1_PI;
 use glam::Vec3;
 
 use super::next_event::PathScope;
+use super::Stage;
 use crate::geometry::Ray;
 use crate::render::integrators::Counters;
 use crate::render::world::bsdf::{reflect, refract};
+use crate::render::world::camera::CameraTile;
 use crate::render::world::light::LightSample;
 use crate::render::world::rng::Sampler;
 use crate::render::world::{Hit, World};
@@ -21,6 +23,26 @@ use crate::scene::{MaterialModel, Rgb};
 
 /// Below this path weight a reflection adds nothing visible.
 const MIN_WEIGHT: f32 = 1e-3;
+
+/// Whitted ray tracing, recursing at most `max_depth` times.
+pub struct Whitted {
+    pub max_depth: u32,
+}
+
+impl Whitted {
+    #[inline]
+    pub fn radiance(&self, world: &World, ray: &Ray, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
+        radiance(world, ray, self.max_depth, sampler, counters)
+    }
+
+    /// One sample of every pixel of `tile`, into `out`.
+    pub fn render_tile(&self, stage: &Stage, tile: &CameraTile, out: &mut [Rgb], counters: &mut Counters) {
+        for (i, value) in out.iter_mut().enumerate() {
+            let (ray, mut sampler) = tile.sample(i);
+            *value = self.radiance(stage.world, &ray, &mut sampler, counters);
+        }
+    }
+}
 
 /// Radiance along a camera ray, recursing at most `max_depth` times.
 pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {

@@ -134,6 +134,52 @@ impl CameraModel {
     }
 }
 
+/// A rectangle of the image: what one task of a pass renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TileRect {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl TileRect {
+    pub fn pixels(&self) -> usize {
+        (self.width * self.height) as usize
+    }
+
+    /// Pixel `i` of the tile, row by row, in image coordinates.
+    #[inline]
+    pub fn pixel(&self, i: usize) -> (u32, u32) {
+        (self.x + i as u32 % self.width, self.y + i as u32 / self.width)
+    }
+}
+
+/// The camera samples of one pass over a tile: pixel (x, y) of `rect`, row
+/// by row, as `CameraModel::sample_ray` draws them.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraTile<'a> {
+    pub camera: &'a CameraModel,
+    pub rect: TileRect,
+    pub streams: PassStreams,
+}
+
+impl CameraTile<'_> {
+    pub fn len(&self) -> usize {
+        self.rect.pixels()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Sample `i`'s ray and the stream it leaves, drawn one at a time.
+    pub fn sample(&self, i: usize) -> (Ray, Sampler) {
+        let (x, y) = self.rect.pixel(i);
+        self.camera.sample_ray(x, y, self.streams)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,133 @@
+//! One job from start to end: the scene compiled, the integrator prepared,
+//! a preview, then passes until the job's budget, each pass's statistics
+//! and tiles sent as events. A job stops within a tile of being abandoned:
+//! every tile checks the generation it belongs to.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+use crossbeam_channel::Sender;
+use rayon::prelude::*;
+
+use super::events::{Notify, PassStats, RenderEvent, TileUpdate};
+use crate::render::film::Film;
+use crate::render::integrators::photon_map::PhotonMaps;
+use crate::render::integrators::{Integrator, PassObserver, Stage};
+use crate::render::settings::RenderSettings;
+use crate::render::world::camera::{CameraModel, TileRect};
+use crate::render::world::World;
+use crate::scene::Scene;
+
+/// A scene snapshot and how to render it.
+#[derive(Clone, Debug)]
+pub struct RenderJob {
+    pub scene: Arc<Scene>,
+    pub settings: RenderSettings,
+    /// Photon maps made earlier for this scene and these settings (loaded
+    /// from a file); traced afresh when absent.
+    pub photon_maps: Option<Arc<PhotonMaps>>,
+    /// Send every tile's image after each pass (what a viewport or a
+    /// convergence log reads); a batch render wants only the final image.
+    pub stream_tiles: bool,
+}
+
+impl RenderJob {
+    pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Self {
+        Self { scene, settings, photon_maps: None, stream_tiles: true }
+    }
+}
+
+/// The job's side of the session: which generation it is, and where its
+/// events go.
+pub(super) struct JobContext<'a> {
+    pub generation: u64,
+    pub stream_tiles: bool,
+    pub current: &'a AtomicU64,
+    pub events: &'a Sender<RenderEvent>,
+    pub notify: Option<&'a Notify>,
+}
+
+impl JobContext<'_> {
+    fn send(&self, event: RenderEvent) {
+        // The receiver is gone only when the session was dropped, and then
+        // nobody is left to tell
+        let _ = self.events.send(event);
+        if let Some(notify) = self.notify {
+            notify();
+        }
+    }
+}
+
+impl PassObserver for JobContext<'_> {
+    fn is_current(&self) -> bool {
+        self.current.load(Ordering::Relaxed) == self.generation
+    }
+
+    fn wants_tiles(&self) -> bool {
+        self.stream_tiles
+    }
+
+    fn tile(&self, rect: TileRect, pixels: Vec<[f32; 3]>) {
+        self.send(RenderEvent::Tile(TileUpdate { generation: self.generation, rect, pixels, preview: false }));
+    }
+}
+
+pub(super) fn run_job(context: &JobContext, job: &RenderJob) {
+    let settings = &job.settings;
+    let generation = context.generation;
+    if let Some(problem) = job.scene.validate().into_iter().next() {
+        context.send(RenderEvent::Failed { generation, message: problem.to_string() });
+        return;
+    }
+    if let Some(problem) = settings.problems().into_iter().next() {
+        context.send(RenderEvent::Failed { generation, message: problem.to_string() });
+        return;
+    }
+    let camera = CameraModel::new(&job.scene.camera, settings.width, settings.height);
+    let (world, visible_radius) = World::for_view(&job.scene, &camera, settings.width, settings.height);
+    let stage = Stage { world: &world, camera: &camera, settings };
+    let start = Instant::now();
+    let mut film = Film::new(settings.width, settings.height, settings.tile_size);
+    let Some(mut integrator) = Integrator::prepare(&stage, &film, visible_radius, job.photon_maps.clone(), context)
+    else {
+        return;
+    };
+    if let Some(stats) = integrator.photon_maps() {
+        context.send(RenderEvent::PhotonMaps { generation, stats });
+    }
+    context.send(RenderEvent::Started { generation, width: settings.width, height: settings.height });
+
+    if settings.preview {
+        film.tiles.par_iter().for_each(|tile| {
+            if context.is_current() {
+                let pixels = integrator.preview_tile(&stage, tile.rect);
+                context.send(RenderEvent::Tile(TileUpdate { generation, rect: tile.rect, pixels, preview: true }));
+            }
+        });
+    }
+
+    let mut stats = PassStats::default();
+    loop {
+        let done_spp = settings.samples_per_pixel.is_some_and(|spp| stats.passes >= spp);
+        let done_time =
+            settings.time_limit.is_some_and(|limit| stats.passes > 0 && start.elapsed().as_secs_f64() >= limit);
+        if done_spp || done_time {
+            break;
+        }
+        let pass_start = Instant::now();
+        let Some(report) = integrator.pass(&stage, &mut film, stats.passes, context) else {
+            return;
+        };
+        stats.rays += report.counters.rays;
+        stats.non_finite += report.counters.non_finite;
+        stats.passes += 1;
+        stats.samples += settings.width as u64 * settings.height as u64;
+        stats.pass_time = pass_start.elapsed();
+        stats.elapsed = start.elapsed();
+        stats.photon = report.photon;
+        context.send(RenderEvent::PassFinished { generation, stats });
+    }
+    let image = film.image(|tile| integrator.tile_pixels(&film, tile));
+    context.send(RenderEvent::Finished { generation, image: Arc::new(image), stats });
+}

@@ -1,0 +1,173 @@
+//! The film: what passes accumulate into. The image is cut into tiles,
+//! rendered centre first, each owning its sums, so parallel passes need no
+//! locks. Methods that trace from the lights splat to any pixel: their
+//! splats are collected per chunk of work and added in chunk order, so the
+//! image never depends on which thread ran what.
+
+use crate::render::image::LinearImage;
+use crate::render::world::camera::TileRect;
+use crate::scene::Rgb;
+
+/// Tiles covering `width × height`, ordered by distance from the centre: the
+/// part a user looks at sharpens first.
+pub fn tile_layout(width: u32, height: u32, tile_size: u32) -> Vec<TileRect> {
+    let size = tile_size.max(1);
+    let mut tiles = Vec::new();
+    for y in (0..height).step_by(size as usize) {
+        for x in (0..width).step_by(size as usize) {
+            tiles.push(TileRect { x, y, width: size.min(width - x), height: size.min(height - y) });
+        }
+    }
+    let (cx, cy) = (width as f32 * 0.5, height as f32 * 0.5);
+    let distance = |t: &TileRect| {
+        let dx = t.x as f32 + t.width as f32 * 0.5 - cx;
+        let dy = t.y as f32 + t.height as f32 * 0.5 - cy;
+        dx * dx + dy * dy
+    };
+    tiles.sort_by(|a, b| distance(a).total_cmp(&distance(b)));
+    tiles
+}
+
+/// Per-pixel sums of one tile, in f64 so thousands of passes add up exactly
+/// enough.
+#[derive(Clone, Debug)]
+pub struct FilmTile {
+    pub rect: TileRect,
+    pub sums: Vec<[f64; 3]>,
+    /// Passes added to every pixel of the tile.
+    pub samples: u32,
+}
+
+impl FilmTile {
+    pub fn new(rect: TileRect) -> Self {
+        Self { rect, sums: vec![[0.0; 3]; rect.pixels()], samples: 0 }
+    }
+
+    /// The tile's current estimate, row-major.
+    pub fn mean(&self) -> Vec<[f32; 3]> {
+        let scale = 1.0 / self.samples.max(1) as f64;
+        self.sums.iter().map(|s| s.map(|c| (c * scale) as f32)).collect()
+    }
+
+    /// Add one value (a sample, or the splats' sum) to pixel `i` of the tile.
+    #[inline]
+    pub fn add(&mut self, i: usize, value: Rgb) {
+        let sum = &mut self.sums[i];
+        for c in 0..3 {
+            sum[c] += value[c] as f64;
+        }
+    }
+}
+
+/// A contribution to any pixel of the film (light tracing's camera
+/// connections, BDPT's t = 1 strategies).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Splat {
+    pub x: u32,
+    pub y: u32,
+    pub value: Rgb,
+}
+
+#[derive(Clone, Debug)]
+pub struct Film {
+    pub width: u32,
+    pub height: u32,
+    tile_size: u32,
+    pub tiles: Vec<FilmTile>,
+    /// Which tile holds each cell of the tile grid (the tiles are sorted).
+    tile_of_cell: Vec<u32>,
+}
+
+impl Film {
+    pub fn new(width: u32, height: u32, tile_size: u32) -> Self {
+        let tile_size = tile_size.max(1);
+        let tiles: Vec<FilmTile> = tile_layout(width, height, tile_size).into_iter().map(FilmTile::new).collect();
+        let columns = width.div_ceil(tile_size);
+        let mut tile_of_cell = vec![0; (columns * height.div_ceil(tile_size)) as usize];
+        for (i, tile) in tiles.iter().enumerate() {
+            tile_of_cell[(tile.rect.y / tile_size * columns + tile.rect.x / tile_size) as usize] = i as u32;
+        }
+        Self { width, height, tile_size, tiles, tile_of_cell }
+    }
+
+    /// Add one pass's splats: `chunks` in the order the work was numbered
+    /// (not the order threads finished it), each chunk's splats in order.
+    /// Splats off the film are dropped.
+    pub fn add_splats(&mut self, chunks: impl IntoIterator<Item = Vec<Splat>>) {
+        let columns = self.width.div_ceil(self.tile_size);
+        for splat in chunks.into_iter().flatten() {
+            if splat.x >= self.width || splat.y >= self.height {
+                continue;
+            }
+            let cell = splat.y / self.tile_size * columns + splat.x / self.tile_size;
+            let tile = &mut self.tiles[self.tile_of_cell[cell as usize] as usize];
+            let rect = tile.rect;
+            tile.add(((splat.y - rect.y) * rect.width + splat.x - rect.x) as usize, splat.value);
+        }
+    }
+
+    /// The whole image from each tile's pixels (`tile_pixels(i)` row-major).
+    pub fn image(&self, tile_pixels: impl Fn(usize) -> Vec<[f32; 3]>) -> LinearImage {
+        let mut image = LinearImage::new(self.width, self.height);
+        for (i, tile) in self.tiles.iter().enumerate() {
+            for (k, pixel) in tile_pixels(i).into_iter().enumerate() {
+                let (x, y) = tile.rect.pixel(k);
+                image.pixels[(y * self.width + x) as usize] = pixel;
+            }
+        }
+        image
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiles_cover_every_pixel_once_centre_first() {
+        let (w, h) = (100, 70);
+        let tiles = tile_layout(w, h, 32);
+        let mut covered = vec![0u8; (w * h) as usize];
+        for t in &tiles {
+            for y in t.y..t.y + t.height {
+                for x in t.x..t.x + t.width {
+                    covered[(y * w + x) as usize] += 1;
+                }
+            }
+        }
+        assert!(covered.iter().all(|c| *c == 1));
+        let first = tiles[0];
+        assert!(first.x <= 50 && 50 < first.x + first.width && first.y <= 35 && 35 < first.y + first.height);
+    }
+
+    /// Splats land on their pixel whichever tile holds it, and the film does
+    /// not depend on how the work was split into chunks, only on its order.
+    #[test]
+    fn splats_land_on_their_pixels_in_chunk_order() {
+        let (w, h) = (70, 45);
+        let mut splats = Vec::new();
+        let mut state = 1u64;
+        for _ in 0..5000 {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let (x, y) = ((state >> 33) as u32 % (w + 3), (state >> 13) as u32 % (h + 2));
+            splats.push(Splat { x, y, value: Rgb::splat((state >> 40) as f32 / 1e6 + 1e-3) });
+        }
+        let mut whole = Film::new(w, h, 16);
+        whole.add_splats([splats.clone()]);
+        let mut chunked = Film::new(w, h, 16);
+        chunked.add_splats(splats.chunks(37).map(<[Splat]>::to_vec));
+        let mut expected = vec![[0.0f64; 3]; (w * h) as usize];
+        for s in splats.iter().filter(|s| s.x < w && s.y < h) {
+            let pixel = &mut expected[(s.y * w + s.x) as usize];
+            (0..3).for_each(|c| pixel[c] += s.value[c] as f64);
+        }
+        for film in [&whole, &chunked] {
+            for tile in &film.tiles {
+                for (i, sum) in tile.sums.iter().enumerate() {
+                    let (x, y) = tile.rect.pixel(i);
+                    assert_eq!(*sum, expected[(y * w + x) as usize], "pixel ({x}, {y})");
+                }
+            }
+        }
+    }
+}
