@@ -87,7 +87,7 @@ fn sppm_caustics(c: &mut Criterion) {
         samples_per_pixel: Some(1),
         ..RenderSettings::for_algorithm(Algorithm::Sppm)
     };
-    settings.photon.sppm_photons_per_pass = 1_000_000;
+    settings.set_photons(1_000_000);
     let job = RenderJob::new(scene, settings);
     let mut group = c.benchmark_group("render");
     group.sample_size(10);

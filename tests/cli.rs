@@ -121,18 +121,19 @@ fn broken_scene_exits_non_zero_naming_file_line_and_field_without_writing() {
 #[test]
 fn photon_statistics_are_printed() {
     let dir = temp_dir("photons");
-    let run = |algo: &str| {
+    let run = |algo: &str, photons: &[&str]| {
         let output = gi_studio()
             .args(["render", "assets/scenes/caustics.ron", "--algo", algo])
             .args(["--spp", "3", "--width", "32", "--height", "24"])
-            .args(["--global-photons", "5000", "--caustic-photons", "5000", "--sppm-photons", "5000", "-o"])
+            .args(photons)
+            .arg("-o")
             .arg(dir.join(format!("{algo}.png")))
             .output()
             .unwrap();
         assert_exit(&output, 0);
         stdout(&output)
     };
-    let photon = run("photon");
+    let photon = run("photon", &["--global-photons", "5000", "--caustic-photons", "5000"]);
     for map in ["global", "caustic"] {
         let line = photon.lines().find(|l| l.starts_with(&format!("{map} map:"))).expect(map);
         assert_eq!(number_before(line, "emitted"), 5000.0, "{line}");
@@ -143,7 +144,7 @@ fn photon_statistics_are_printed() {
     let queries = number_before(knn, "queries");
     assert!(queries > 0.0 && queries <= (2 * 32 * 24) as f64, "{knn}");
     assert!(number_before(knn, "nodes") > 0.0 && knn.contains("gather radius"), "{knn}");
-    let sppm = run("sppm");
+    let sppm = run("sppm", &["--sppm-photons", "5000"]);
     assert!(sppm.contains("SPPM mean radius per pass [1: ") && sppm.contains("3: "), "{sppm}");
     assert_eq!(number_before(&sppm, "photons"), 5000.0, "{sppm}");
 }
@@ -303,6 +304,20 @@ fn values_out_of_their_limits_are_refused_by_name() {
     let output = gi_studio().args(["bench", "--budget", "inf"]).output().unwrap();
     assert_exit(&output, 2);
     assert!(!Path::new("never.png").exists());
+}
+
+/// Each algorithm takes only its own knobs: another's is refused by name.
+#[test]
+fn a_knob_of_another_algorithm_is_refused() {
+    for (algo, flag) in [("path", "--global-photons=10"), ("sppm", "--k=20"), ("photon", "--sppm-alpha=0.5")] {
+        let output = gi_studio()
+            .args(["render", "assets/scenes/cornell.ron", "-o", "never.png", "--algo", algo, flag])
+            .output()
+            .unwrap();
+        assert_exit(&output, 1);
+        let name = flag.split('=').next().unwrap();
+        assert!(stderr(&output).contains(&format!("{name} does not apply to --algo {algo}")), "{}", stderr(&output));
+    }
 }
 
 #[test]

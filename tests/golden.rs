@@ -47,9 +47,7 @@ fn golden_render(preset: &str, algorithm: Algorithm) -> LinearImage {
         seed: 20_261_201,
         ..RenderSettings::for_algorithm(algorithm)
     };
-    settings.photon.global_photons = 20_000;
-    settings.photon.caustic_photons = 20_000;
-    settings.photon.sppm_photons_per_pass = 20_000;
+    settings.set_photons(20_000);
     render_blocking(&RenderJob::new(Arc::new(scene), settings)).unwrap().0
 }
 

@@ -450,7 +450,7 @@ fn case_13_analytic_furnace() {
     let path = mean_luminance(&render(&inside, settings(Algorithm::Path, 16, 12, 256)).0.pixels);
     assert!((path - 1.0).abs() < 0.025, "path: {path}");
     let mut sppm = settings(Algorithm::Sppm, 16, 12, 64);
-    sppm.photon.sppm_photons_per_pass = 20_000;
+    sppm.set_photons(20_000);
     let progressive = mean_luminance(&render(&inside, sppm).0.pixels);
     assert!((progressive - 1.0).abs() < 0.025, "sppm: {progressive}");
     let direct = mean_luminance(&render(&inside, settings(Algorithm::Whitted, 16, 12, 1)).0.pixels);
@@ -604,9 +604,7 @@ fn case_15_degenerate_inputs() {
     let on_surface = floor_scene(0.5, vec![light("bulb", LightKind::Point { position: Vec3::ZERO }, 5.0)]);
     for algorithm in Algorithm::ALL {
         let mut s = settings(algorithm, 16, 12, 2);
-        s.photon.global_photons = 2_000;
-        s.photon.caustic_photons = 2_000;
-        s.photon.sppm_photons_per_pass = 2_000;
+        s.set_photons(2_000);
         render(&on_surface, s);
     }
 }
@@ -646,7 +644,7 @@ fn case_16_awkward_photon_maps() {
 fn case_17_sppm_thousands_of_passes() {
     let scene = presets::preset("cornell").unwrap().unwrap();
     let mut s = settings(Algorithm::Sppm, 4, 3, 2000);
-    s.photon.sppm_photons_per_pass = 500;
+    s.set_photons(500);
     let session = gi_studio::render::RenderSession::new(None).unwrap();
     let generation = session.start(RenderJob::new(Arc::new(scene), s));
     let mut last_radius = f32::INFINITY;
@@ -811,9 +809,7 @@ fn case_20_photon_mapping_plateaus_sppm_does_not() {
     let reference = LinearImage::load(std::path::Path::new(&path)).unwrap().downsample(8);
     let error = |algorithm: Algorithm, passes: u32| {
         let mut s = settings(algorithm, reference.width, reference.height, passes);
-        s.photon.global_photons = 20_000;
-        s.photon.caustic_photons = 20_000;
-        s.photon.sppm_photons_per_pass = 20_000;
+        s.set_photons(20_000);
         rel_mse(&render(&scene, s).0, &reference, RelMseOptions::default()).unwrap()
     };
     let (photon_early, photon_late) = (error(Algorithm::Photon, 8), error(Algorithm::Photon, 128));

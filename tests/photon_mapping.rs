@@ -68,8 +68,9 @@ fn photon_mapping_agrees_with_converged_path_tracing_on_a_diffuse_scene() {
     let scene = diffuse_cornell();
     let reference = render(&scene, settings(Algorithm::Path, 40, 30, 2048));
     let mut photon = settings(Algorithm::Photon, 40, 30, 64);
-    photon.photon.global_photons = 1_000_000;
-    photon.photon.k_nearest = 100;
+    let p = photon.photon_mut().unwrap();
+    p.global_photons = 1_000_000;
+    p.k_nearest = 100;
     let image = render(&scene, photon);
     let error = rel_mse(&image, &reference, RelMseOptions::default()).unwrap();
     assert!(error < 0.02, "relMSE {error}");
@@ -80,9 +81,10 @@ fn final_gathering_agrees_with_converged_path_tracing_too() {
     let scene = diffuse_cornell();
     let reference = render(&scene, settings(Algorithm::Path, 40, 30, 2048));
     let mut photon = settings(Algorithm::Photon, 40, 30, 16);
-    photon.photon.global_photons = 200_000;
-    photon.photon.final_gather = true;
-    photon.photon.final_gather_rays = 16;
+    let p = photon.photon_mut().unwrap();
+    p.global_photons = 200_000;
+    p.final_gather = true;
+    p.final_gather_rays = 16;
     let image = render(&scene, photon);
     let error = rel_mse(&image, &reference, RelMseOptions::default()).unwrap();
     assert!(error < 0.02, "relMSE {error}");
@@ -93,7 +95,7 @@ fn sppm_error_keeps_falling() {
     let scene = presets::preset("caustics").unwrap().unwrap();
     let reference = render(&scene, settings(Algorithm::Path, 40, 30, 4096));
     let mut sppm = settings(Algorithm::Sppm, 40, 30, 64);
-    sppm.photon.sppm_photons_per_pass = 20_000;
+    sppm.set_photons(20_000);
     let session = RenderSession::new(None).unwrap();
     let generation = session.start(RenderJob::new(Arc::new(scene), sppm));
     let mut errors = Vec::new();
@@ -152,15 +154,14 @@ fn the_caustic_under_the_glass_ball_is_brighter_than_its_surroundings() {
 fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
     let scene = presets::preset("caustics").unwrap().unwrap();
     let mut s = settings(Algorithm::Photon, 32, 24, 2);
-    s.photon.global_photons = 20_000;
-    s.photon.caustic_photons = 20_000;
+    s.set_photons(20_000);
     let camera = CameraModel::new(&scene.camera, s.width, s.height);
     let (world, visible) = World::for_view(&scene, &camera, s.width, s.height);
-    let maps = PhotonMaps::build(&world, &s.photon, s.seed, s.max_depth, visible);
+    let maps = PhotonMaps::build(&world, s.photon().unwrap(), s.seed, s.max_depth, visible);
     let dir = std::env::temp_dir().join(format!("gi-pmap-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("caustics.pmap");
-    let (scene_key, key) = (scene.content_key(), settings_key(&s.photon, s.seed, s.max_depth));
+    let (scene_key, key) = (scene.content_key(), settings_key(s.photon().unwrap(), s.seed, s.max_depth));
     save_photon_maps(&maps, scene_key, key, &path).unwrap();
 
     let fresh = render(&scene, s.clone());
@@ -171,7 +172,7 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
     let mut other_scene = scene.clone();
     other_scene.objects[2].name = "renamed ball".into();
     assert!(matches!(load_photon_maps(&path, other_scene.content_key(), key), Err(PhotonFileError::OtherScene { .. })));
-    let mut other = s.photon.clone();
+    let mut other = s.photon().unwrap().clone();
     other.global_photons += 1;
     assert!(matches!(
         load_photon_maps(&path, scene_key, settings_key(&other, s.seed, s.max_depth)),
@@ -201,15 +202,14 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
 fn damaged_photon_maps_are_refused_each_with_its_own_message() {
     let scene = presets::preset("caustics").unwrap().unwrap();
     let mut s = settings(Algorithm::Photon, 32, 24, 1);
-    s.photon.global_photons = 2_000;
-    s.photon.caustic_photons = 2_000;
+    s.set_photons(2_000);
     let camera = CameraModel::new(&scene.camera, s.width, s.height);
     let (world, visible) = World::for_view(&scene, &camera, s.width, s.height);
-    let maps = PhotonMaps::build(&world, &s.photon, s.seed, s.max_depth, visible);
+    let maps = PhotonMaps::build(&world, s.photon().unwrap(), s.seed, s.max_depth, visible);
     assert!(maps.global.len() > 100);
     let dir = std::env::temp_dir().join(format!("gi-pmap-damage-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let (scene_key, key) = (scene.content_key(), settings_key(&s.photon, s.seed, s.max_depth));
+    let (scene_key, key) = (scene.content_key(), settings_key(s.photon().unwrap(), s.seed, s.max_depth));
     let good = dir.join("good.pmap");
     save_photon_maps(&maps, scene_key, key, &good).unwrap();
     let bytes = std::fs::read(&good).unwrap();
@@ -268,7 +268,7 @@ fn a_light_larger_than_the_scene_delivers_the_right_power() {
     let path = format!("{}/assets/references/smallpt.exr", env!("CARGO_MANIFEST_DIR"));
     let reference = LinearImage::load(std::path::Path::new(&path)).unwrap().downsample(8);
     let mut s = settings(Algorithm::Sppm, reference.width, reference.height, 64);
-    s.photon.sppm_photons_per_pass = 50_000;
+    s.set_photons(50_000);
     let session = RenderSession::new(None).unwrap();
     let generation = session.start(RenderJob::new(Arc::new(scene), s));
     let mut image = LinearImage::new(reference.width, reference.height);

@@ -118,11 +118,10 @@ proptest! {
         let scene = Arc::new(scene);
         for algorithm in Algorithm::ALL {
             let mut settings = RenderSettings { width: 8, height: 6, samples_per_pixel: Some(2), preview: true, ..RenderSettings::for_algorithm(algorithm) };
-            settings.photon.global_photons = 500;
-            settings.photon.caustic_photons = 500;
-            settings.photon.sppm_photons_per_pass = 500;
-            settings.photon.final_gather = algorithm == Algorithm::Photon;
-            settings.photon.final_gather_rays = 2;
+            settings.set_photons(500);
+            if let Some(p) = settings.photon_mut() {
+                (p.final_gather, p.final_gather_rays) = (true, 2);
+            }
             let (image, _) = render_blocking(&RenderJob::new(scene.clone(), settings)).map_err(TestCaseError::fail)?;
             prop_assert!(image.pixels.iter().flatten().all(|c| c.is_finite() && *c >= 0.0), "{algorithm}: a non-finite or negative pixel");
         }

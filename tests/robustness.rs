@@ -174,9 +174,7 @@ fn render_tiny(scene: Scene, algorithm: Algorithm) {
         threads: 1,
         ..RenderSettings::for_algorithm(algorithm)
     };
-    settings.photon.global_photons = 200;
-    settings.photon.caustic_photons = 200;
-    settings.photon.sppm_photons_per_pass = 200;
+    settings.set_photons(200);
     let (image, _) = render_blocking(&RenderJob::new(Arc::new(scene), settings)).expect("a valid scene renders");
     assert!(image.pixels.iter().flatten().all(|c| c.is_finite() && *c >= 0.0), "{algorithm}");
 }
@@ -246,8 +244,10 @@ fn any_flags_give_an_error_or_settings_within_limits() {
     in_capped_child("any_flags_give_an_error_or_settings_within_limits", || {
         let scene = presets::preset("cornell").unwrap().unwrap();
         let accepted = std::sync::atomic::AtomicUsize::new(0);
-        proptest!(fixed_cases(3000, 3), |(flags in prop::collection::vec(flag(), 1..6))| {
+        let algorithms = prop::sample::select(vec!["whitted", "path", "photon", "sppm"]);
+        proptest!(fixed_cases(3000, 3), |(flags in prop::collection::vec(flag(), 1..6), algorithm in algorithms)| {
             let mut argv = vec!["gi-studio".to_owned(), "render".into(), "x.ron".into(), "-o".into(), "x.png".into()];
+            argv.push(format!("--algo={algorithm}"));
             for (flag, value) in &flags {
                 argv.push(format!("{flag}={value}"));
             }

@@ -20,9 +20,7 @@ fn studio(panes: usize) -> Harness<'static, StudioApp> {
         pane.settings.width = 64;
         pane.settings.height = 48;
         pane.settings.samples_per_pixel = Some(2);
-        pane.settings.photon.global_photons = 5_000;
-        pane.settings.photon.caustic_photons = 5_000;
-        pane.settings.photon.sppm_photons_per_pass = 5_000;
+        pane.settings.set_photons(5_000);
     }
     app.restart_all();
     Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app)
@@ -298,7 +296,10 @@ fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
         height: 100_000,
         threads: 100_000,
         tile_size: 0,
-        photon: gi_studio::render::PhotonSettings { k_nearest: u32::MAX, ..Default::default() },
+        method: gi_studio::render::Method::Photon(gi_studio::render::PhotonSettings {
+            k_nearest: u32::MAX,
+            ..Default::default()
+        }),
         ..Default::default()
     };
     let fine =

@@ -138,7 +138,7 @@ impl Pane {
     }
 
     pub fn algorithm(&self) -> Algorithm {
-        self.settings.algorithm
+        self.settings.algorithm()
     }
 
     /// Abandon the current job and render `scene` afresh (never waits).

@@ -23,7 +23,7 @@ use super::viewport::viewport_ui;
 use super::StudioArgs;
 use crate::limits;
 use crate::render::image::ImageFormat;
-use crate::render::{Algorithm, LinearImage, RenderSettings};
+use crate::render::{Algorithm, LinearImage, Method, RenderSettings};
 use crate::scene::{load_scene, presets, save_scene, to_ron, Invalid, Scene};
 
 /// What survives a restart (eframe storage).
@@ -360,8 +360,8 @@ impl StudioApp {
             .into_iter()
             .map(|s| {
                 Some(RenderSettings {
-                    width: self.pane_settings(s.algorithm, count).width,
-                    height: self.pane_settings(s.algorithm, count).height,
+                    width: self.pane_settings(s.algorithm(), count).width,
+                    height: self.pane_settings(s.algorithm(), count).height,
                     ..s
                 })
             })
@@ -598,7 +598,7 @@ impl StudioApp {
         let mut restart = false;
         ui.horizontal(|ui| {
             let pane = &mut self.panes[index];
-            let mut algorithm = pane.settings.algorithm;
+            let mut algorithm = pane.settings.algorithm();
             egui::ComboBox::new(("algorithm", index), format!("pane {}", index + 1))
                 .selected_text(algorithm.label())
                 .show_ui(ui, |ui| {
@@ -606,8 +606,8 @@ impl StudioApp {
                         ui.selectable_value(&mut algorithm, a, a.label());
                     }
                 });
-            if algorithm != pane.settings.algorithm {
-                pane.settings.algorithm = algorithm;
+            if algorithm != pane.settings.algorithm() {
+                pane.settings.method = Method::of(algorithm);
                 pane.settings.max_depth = algorithm.default_max_depth();
                 restart = true;
             }
@@ -819,31 +819,28 @@ fn pane_settings_ui(ui: &mut egui::Ui, pane: &mut Pane) -> bool {
     ui.add(egui::DragValue::new(&mut s.max_depth).range(range(limits::MAX_DEPTH)).prefix("max depth "));
     ui.add(egui::DragValue::new(&mut s.width).range(16..=4096).prefix("width "));
     ui.add(egui::DragValue::new(&mut s.height).range(16..=4096).prefix("height "));
-    if matches!(s.algorithm, Algorithm::Photon | Algorithm::Sppm) {
-        ui.separator();
-        let p = &mut s.photon;
-        let photons = range(limits::PHOTONS);
-        ui.add(
-            egui::DragValue::new(&mut p.global_photons).range(photons.clone()).speed(1000).prefix("global photons "),
-        );
-        ui.add(egui::DragValue::new(&mut p.caustic_photons).range(photons).speed(1000).prefix("caustic photons "));
-        ui.add(egui::DragValue::new(&mut p.k_nearest).range(8..=1000).prefix("k nearest "));
-        ui.add(egui::DragValue::new(&mut p.max_radius).range(0.0..=1e6).speed(0.001).prefix("max radius (0: auto) "));
-        ui.checkbox(&mut p.final_gather, "final gather");
-        ui.add(egui::DragValue::new(&mut p.final_gather_rays).range(1..=1024).prefix("gather rays "));
-        ui.add(
-            egui::DragValue::new(&mut p.sppm_photons_per_pass)
-                .range(range(limits::SPPM_PHOTONS))
-                .speed(1000)
-                .prefix("SPPM photons/pass "),
-        );
-        ui.add(
-            egui::DragValue::new(&mut p.sppm_initial_radius)
-                .range(0.0..=1e6)
-                .speed(0.001)
-                .prefix("SPPM radius (0: auto) "),
-        );
-        ui.add(egui::Slider::new(&mut p.sppm_alpha, 0.05..=1.0).text("SPPM α"));
+    match &mut s.method {
+        Method::Whitted | Method::Path => {}
+        Method::Photon(p) => {
+            ui.separator();
+            let photons = range(limits::PHOTONS);
+            let global = egui::DragValue::new(&mut p.global_photons).range(photons.clone()).speed(1000);
+            ui.add(global.prefix("global photons "));
+            ui.add(egui::DragValue::new(&mut p.caustic_photons).range(photons).speed(1000).prefix("caustic photons "));
+            ui.add(egui::DragValue::new(&mut p.k_nearest).range(8..=1000).prefix("k nearest "));
+            let radius = egui::DragValue::new(&mut p.max_radius).range(0.0..=1e6).speed(0.001);
+            ui.add(radius.prefix("max radius (0: auto) "));
+            ui.checkbox(&mut p.final_gather, "final gather");
+            ui.add(egui::DragValue::new(&mut p.final_gather_rays).range(1..=1024).prefix("gather rays "));
+        }
+        Method::Sppm(p) => {
+            ui.separator();
+            let photons = egui::DragValue::new(&mut p.photons_per_pass).range(range(limits::SPPM_PHOTONS)).speed(1000);
+            ui.add(photons.prefix("photons per pass "));
+            let radius = egui::DragValue::new(&mut p.initial_radius).range(0.0..=1e6).speed(0.001);
+            ui.add(radius.prefix("initial radius (0: auto) "));
+            ui.add(egui::Slider::new(&mut p.alpha, 0.05..=1.0).text("α"));
+        }
     }
     ui.separator();
     if ui.add(egui::Slider::new(&mut pane.exposure, -8.0..=8.0).text("exposure (stops)")).changed() {

@@ -68,7 +68,7 @@ pub fn measure(
 ) -> Result<Run> {
     let session = RenderSession::new(None).context("could not start the render worker")?;
     let (width, height) = (settings.width, settings.height);
-    let algorithm = settings.algorithm;
+    let algorithm = settings.algorithm();
     let generation = session.start(RenderJob::new(Arc::new(scene.clone()), settings));
     let mut image = LinearImage::new(width, height);
     let mut log = ConvergenceLog::default();

@@ -11,7 +11,7 @@ pub mod render;
 use clap::{Args, Parser, Subcommand};
 
 use crate::limits;
-use crate::render::Algorithm;
+use crate::render::{Algorithm, Method, PhotonSettings, SppmSettings};
 
 /// The headless commands alone (the binary adds the studio's flags).
 #[derive(Debug, Parser)]
@@ -68,10 +68,13 @@ pub struct RenderFlags {
     pub force: bool,
     #[command(flatten)]
     pub photon: PhotonFlags,
+    #[command(flatten)]
+    pub sppm: SppmFlags,
 }
 
 /// Photon mapping's knobs; defaults as in `PhotonSettings`.
 #[derive(Debug, Args, Clone)]
+#[command(next_help_heading = "Photon mapping (--algo photon, and the photons command)")]
 pub struct PhotonFlags {
     /// Photons emitted for the global map.
     #[arg(long, value_parser = |s: &str| limits::PHOTONS.parse(s))]
@@ -91,30 +94,86 @@ pub struct PhotonFlags {
     /// Rays per final gather.
     #[arg(long, value_parser = |s: &str| limits::GATHER_RAYS.parse(s))]
     pub gather_rays: Option<u32>,
-    /// SPPM: photons per pass.
+}
+
+impl PhotonFlags {
+    /// The first flag given, if any (to refuse it where it does not apply).
+    fn given(&self) -> Option<&'static str> {
+        [
+            (self.global_photons.is_some(), "--global-photons"),
+            (self.caustic_photons.is_some(), "--caustic-photons"),
+            (self.k_nearest.is_some(), "--k"),
+            (self.max_radius.is_some(), "--max-radius"),
+            (self.final_gather, "--final-gather"),
+            (self.gather_rays.is_some(), "--gather-rays"),
+        ]
+        .into_iter()
+        .find_map(|(given, name)| given.then_some(name))
+    }
+
+    /// The flags given, over `p` (each was checked as it was parsed).
+    pub fn apply(&self, p: &mut PhotonSettings) {
+        p.global_photons = self.global_photons.unwrap_or(p.global_photons);
+        p.caustic_photons = self.caustic_photons.unwrap_or(p.caustic_photons);
+        p.k_nearest = self.k_nearest.unwrap_or(p.k_nearest);
+        p.max_radius = self.max_radius.unwrap_or(p.max_radius);
+        p.final_gather |= self.final_gather;
+        p.final_gather_rays = self.gather_rays.unwrap_or(p.final_gather_rays);
+    }
+}
+
+/// Progressive photon mapping's knobs; defaults as in `SppmSettings`.
+#[derive(Debug, Args, Clone)]
+#[command(next_help_heading = "Progressive photon mapping (--algo sppm)")]
+pub struct SppmFlags {
+    /// Photons per pass.
     #[arg(long, value_parser = |s: &str| limits::SPPM_PHOTONS.parse(s))]
     pub sppm_photons: Option<u32>,
-    /// SPPM: initial gather radius (0 = from the scene's size).
+    /// Initial gather radius (0 = from the scene's size).
     #[arg(long, value_parser = |s: &str| limits::LENGTH.parse(s))]
     pub sppm_radius: Option<f32>,
-    /// SPPM: radius reduction α in (0, 1].
+    /// Radius reduction α in (0, 1].
     #[arg(long, value_parser = |s: &str| limits::SPPM_ALPHA.parse(s))]
     pub sppm_alpha: Option<f32>,
 }
 
-impl PhotonFlags {
-    /// The flags given, over `settings` (each was checked as it was parsed).
-    pub fn apply(&self, settings: &mut crate::render::PhotonSettings) {
-        let p = settings;
-        let set = |target: &mut u32, value: Option<u32>| *target = value.unwrap_or(*target);
-        set(&mut p.global_photons, self.global_photons);
-        set(&mut p.caustic_photons, self.caustic_photons);
-        set(&mut p.k_nearest, self.k_nearest);
-        set(&mut p.final_gather_rays, self.gather_rays);
-        set(&mut p.sppm_photons_per_pass, self.sppm_photons);
-        p.max_radius = self.max_radius.unwrap_or(p.max_radius);
-        p.sppm_initial_radius = self.sppm_radius.unwrap_or(p.sppm_initial_radius);
-        p.sppm_alpha = self.sppm_alpha.unwrap_or(p.sppm_alpha);
-        p.final_gather |= self.final_gather;
+impl SppmFlags {
+    fn given(&self) -> Option<&'static str> {
+        [
+            (self.sppm_photons.is_some(), "--sppm-photons"),
+            (self.sppm_radius.is_some(), "--sppm-radius"),
+            (self.sppm_alpha.is_some(), "--sppm-alpha"),
+        ]
+        .into_iter()
+        .find_map(|(given, name)| given.then_some(name))
+    }
+
+    pub fn apply(&self, p: &mut SppmSettings) {
+        p.photons_per_pass = self.sppm_photons.unwrap_or(p.photons_per_pass);
+        p.initial_radius = self.sppm_radius.unwrap_or(p.initial_radius);
+        p.alpha = self.sppm_alpha.unwrap_or(p.alpha);
+    }
+}
+
+impl RenderFlags {
+    /// `algorithm` with the knobs the flags give it; a knob of another
+    /// algorithm is refused, naming both.
+    pub fn method(&self, algorithm: Algorithm) -> anyhow::Result<Method> {
+        let mut method = Method::of(algorithm);
+        let misplaced = match &mut method {
+            Method::Photon(p) => {
+                self.photon.apply(p);
+                self.sppm.given()
+            }
+            Method::Sppm(p) => {
+                self.sppm.apply(p);
+                self.photon.given()
+            }
+            Method::Whitted | Method::Path => self.photon.given().or(self.sppm.given()),
+        };
+        match misplaced {
+            Some(flag) => anyhow::bail!("{flag} does not apply to --algo {algorithm}"),
+            None => Ok(method),
+        }
     }
 }

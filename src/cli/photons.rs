@@ -14,6 +14,7 @@ use crate::render::integrators::photon_map::file::{save_photon_maps, settings_ke
 use crate::render::integrators::photon_map::PhotonMaps;
 use crate::render::world::camera::CameraModel;
 use crate::render::world::World;
+use crate::render::{Algorithm, Method};
 use crate::scene::load_scene;
 
 #[derive(Debug, Args)]
@@ -32,7 +33,11 @@ pub fn run(args: &PhotonsArgs) -> Result<()> {
     let mut outputs = Outputs::new(args.flags.force);
     outputs.input(&args.scene);
     outputs.claim(&args.output, &[MAGIC])?;
-    let settings = args.flags.settings(&scene)?;
+    // The maps are photon mapping's, whatever --algo says
+    let settings = args.flags.settings_as(&scene, Algorithm::Photon)?;
+    let Method::Photon(photon) = &settings.method else {
+        unreachable!("settings_as(Photon) gives photon mapping");
+    };
     let bar = ProgressBar::new_spinner().with_message("tracing photons");
     bar.enable_steady_tick(Duration::from_millis(120));
     let camera = CameraModel::new(&scene.camera, settings.width, settings.height);
@@ -41,10 +46,9 @@ pub fn run(args: &PhotonsArgs) -> Result<()> {
         .num_threads(settings.threads)
         .build()
         .with_context(|| format!("could not start {} threads", settings.threads))?;
-    let maps =
-        pool.install(|| PhotonMaps::build(&world, &settings.photon, settings.seed, settings.max_depth, visible_radius));
+    let maps = pool.install(|| PhotonMaps::build(&world, photon, settings.seed, settings.max_depth, visible_radius));
     bar.finish_and_clear();
-    let key = settings_key(&settings.photon, settings.seed, settings.max_depth);
+    let key = settings_key(photon, settings.seed, settings.max_depth);
     save_photon_maps(&maps, scene.content_key(), key, &args.output)?;
     println!("{}", map_line("global", &maps.stats.global));
     println!("{}", map_line("caustic", &maps.stats.caustic));

@@ -66,7 +66,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         outcome.image.save(&output, 0.0)?;
         let info = ReferenceInfo {
             scene: scene_path.display().to_string(),
-            algorithm: settings.algorithm.name().into(),
+            algorithm: settings.algorithm().name().into(),
             width: settings.width,
             height: settings.height,
             samples_per_pixel: outcome.stats.passes,

@@ -15,7 +15,7 @@ use crate::render::image::ImageFormat;
 use crate::render::integrators::photon_map::file::{load_photon_maps, settings_key};
 use crate::render::integrators::photon_map::maps::MapStats;
 use crate::render::integrators::photon_map::PhotonMapStats;
-use crate::render::{Algorithm, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
+use crate::render::{Algorithm, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
 use crate::scene::{load_scene, Scene};
 
 #[derive(Debug, Args)]
@@ -44,7 +44,13 @@ pub struct RenderOutcome {
 impl RenderFlags {
     /// Settings for `scene`, flags overriding the scene's own.
     pub fn settings(&self, scene: &Scene) -> Result<RenderSettings> {
-        let mut settings = RenderSettings::for_algorithm(self.algorithm);
+        self.settings_as(scene, self.algorithm)
+    }
+
+    /// Settings for `scene` with `algorithm` (whatever `--algo` says).
+    pub fn settings_as(&self, scene: &Scene, algorithm: Algorithm) -> Result<RenderSettings> {
+        let mut settings = RenderSettings::for_algorithm(algorithm);
+        settings.method = self.method(algorithm)?;
         settings.width = self.width.unwrap_or(scene.settings.width);
         settings.height = self.height.unwrap_or(scene.settings.height);
         settings.samples_per_pixel = match (self.spp, self.time) {
@@ -58,7 +64,6 @@ impl RenderFlags {
             settings.max_depth = depth;
         }
         settings.firefly_clamp = self.clamp;
-        self.photon.apply(&mut settings.photon);
         // Each flag was checked as it was parsed; what is left is the image
         // size they make together with the scene's
         if let Some(problem) = settings.problems().into_iter().next() {
@@ -81,10 +86,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let exposure = args.flags.exposure.unwrap_or(scene.settings.exposure);
     let mut job = RenderJob::new(Arc::new(scene), settings.clone());
     if let Some(path) = &args.photon_map {
-        if settings.algorithm != Algorithm::Photon {
+        let Method::Photon(photon) = &settings.method else {
             bail!("--photon-map is for --algo photon");
-        }
-        let keys = (job.scene.content_key(), settings_key(&settings.photon, settings.seed, settings.max_depth));
+        };
+        let keys = (job.scene.content_key(), settings_key(photon, settings.seed, settings.max_depth));
         job.photon_maps = Some(Arc::new(load_photon_maps(path, keys.0, keys.1)?));
     }
     let outcome = render_with_progress(job)?;
@@ -178,7 +183,7 @@ pub fn render_with_progress(job: RenderJob) -> Result<RenderOutcome> {
                 bar.set_message("photon maps built");
             }
             RenderEvent::PassFinished { stats, .. } => {
-                if settings.algorithm == Algorithm::Sppm {
+                if settings.algorithm() == Algorithm::Sppm {
                     radii.push(stats.photon.mean_radius);
                 }
                 bar.set_position(if timed { (stats.elapsed.as_secs_f64() * 10.0) as u64 } else { stats.passes as u64 });
@@ -201,7 +206,7 @@ pub fn summary_line(settings: &RenderSettings, stats: &PassStats, output: &str) 
         "{}×{} {} {} spp in {:.2} s: {:.2} M samples/s, {:.2} M rays/s, {} non-finite samples discarded → {output}",
         settings.width,
         settings.height,
-        settings.algorithm,
+        settings.algorithm(),
         stats.passes,
         stats.elapsed.as_secs_f64(),
         stats.samples_per_second() / 1e6,

@@ -19,4 +19,4 @@ pub mod world;
 pub use engine::{render_blocking, PassStats, RenderEvent, RenderJob, RenderSession, TileUpdate};
 pub use image::LinearImage;
 pub use integrators::PhotonPassStats;
-pub use settings::{Algorithm, PhotonSettings, RenderSettings};
+pub use settings::{Algorithm, Method, PhotonSettings, RenderSettings, SppmSettings};

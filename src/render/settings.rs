@@ -63,23 +63,48 @@ impl FromStr for Algorithm {
     }
 }
 
-/// Photon mapping's knobs (Jensen's two maps, and SPPM).
+/// An algorithm with the knobs that apply to it, and no others.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Method {
+    Whitted,
+    Path,
+    Photon(PhotonSettings),
+    Sppm(SppmSettings),
+}
+
+impl Method {
+    pub fn algorithm(&self) -> Algorithm {
+        match self {
+            Method::Whitted => Algorithm::Whitted,
+            Method::Path => Algorithm::Path,
+            Method::Photon(_) => Algorithm::Photon,
+            Method::Sppm(_) => Algorithm::Sppm,
+        }
+    }
+
+    /// `algorithm` with its default knobs.
+    pub fn of(algorithm: Algorithm) -> Self {
+        match algorithm {
+            Algorithm::Whitted => Method::Whitted,
+            Algorithm::Path => Method::Path,
+            Algorithm::Photon => Method::Photon(PhotonSettings::default()),
+            Algorithm::Sppm => Method::Sppm(SppmSettings::default()),
+        }
+    }
+}
+
+/// Jensen's photon mapping: two maps and their estimate.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct PhotonSettings {
     pub global_photons: u32,
     pub caustic_photons: u32,
-    /// Photons gathered per radiance estimate (at least 8 are used).
+    /// Photons gathered per radiance estimate.
     pub k_nearest: u32,
     /// Largest gather radius; 0 picks one from the scene's size.
     pub max_radius: f32,
     pub final_gather: bool,
     pub final_gather_rays: u32,
-    /// SPPM: photons traced per pass, starting radius (0 = from the scene's
-    /// size) and the radius reduction α.
-    pub sppm_photons_per_pass: u32,
-    pub sppm_initial_radius: f32,
-    pub sppm_alpha: f32,
 }
 
 impl Default for PhotonSettings {
@@ -91,17 +116,30 @@ impl Default for PhotonSettings {
             max_radius: 0.0,
             final_gather: false,
             final_gather_rays: 32,
-            sppm_photons_per_pass: 200_000,
-            sppm_initial_radius: 0.0,
-            sppm_alpha: 2.0 / 3.0,
         }
+    }
+}
+
+/// Progressive photon mapping: photons per pass, the starting radius (0 =
+/// from the scene's size) and the radius reduction α.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SppmSettings {
+    pub photons_per_pass: u32,
+    pub initial_radius: f32,
+    pub alpha: f32,
+}
+
+impl Default for SppmSettings {
+    fn default() -> Self {
+        Self { photons_per_pass: 200_000, initial_radius: 0.0, alpha: 2.0 / 3.0 }
     }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct RenderSettings {
-    pub algorithm: Algorithm,
+    pub method: Method,
     pub width: u32,
     pub height: u32,
     /// Stop after this many samples per pixel (one per pass); None: no limit.
@@ -118,13 +156,12 @@ pub struct RenderSettings {
     /// Show one sample per 8×8 block first, so something is on screen at once.
     pub preview: bool,
     pub tile_size: u32,
-    pub photon: PhotonSettings,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
-            algorithm: Algorithm::Path,
+            method: Method::Path,
             width: 640,
             height: 480,
             samples_per_pixel: None,
@@ -135,14 +172,51 @@ impl Default for RenderSettings {
             firefly_clamp: 0.0,
             preview: false,
             tile_size: 32,
-            photon: PhotonSettings::default(),
         }
     }
 }
 
 impl RenderSettings {
     pub fn for_algorithm(algorithm: Algorithm) -> Self {
-        Self { algorithm, max_depth: algorithm.default_max_depth(), ..Self::default() }
+        Self { method: Method::of(algorithm), max_depth: algorithm.default_max_depth(), ..Self::default() }
+    }
+
+    pub fn algorithm(&self) -> Algorithm {
+        self.method.algorithm()
+    }
+
+    /// `count` photons for each map (photon mapping) or each pass (SPPM);
+    /// the other methods trace none.
+    pub fn set_photons(&mut self, count: u32) {
+        match &mut self.method {
+            Method::Photon(p) => (p.global_photons, p.caustic_photons) = (count, count),
+            Method::Sppm(p) => p.photons_per_pass = count,
+            Method::Whitted | Method::Path => {}
+        }
+    }
+
+    /// Photon mapping's knobs, when that is the method.
+    pub fn photon(&self) -> Option<&PhotonSettings> {
+        match &self.method {
+            Method::Photon(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// Photon mapping's knobs, when that is the method.
+    pub fn photon_mut(&mut self) -> Option<&mut PhotonSettings> {
+        match &mut self.method {
+            Method::Photon(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// SPPM's knobs, when that is the method.
+    pub fn sppm_mut(&mut self) -> Option<&mut SppmSettings> {
+        match &mut self.method {
+            Method::Sppm(p) => Some(p),
+            _ => None,
+        }
     }
 }
 
@@ -171,15 +245,21 @@ impl RenderSettings {
         check("max_depth", ok(limits::MAX_DEPTH.check(self.max_depth)));
         check("firefly_clamp", ok(limits::LENGTH.check(self.firefly_clamp)));
         check("tile_size", ok(limits::TILE_SIZE.check(self.tile_size)));
-        let p = &self.photon;
-        check("global_photons", ok(limits::PHOTONS.check(p.global_photons)));
-        check("caustic_photons", ok(limits::PHOTONS.check(p.caustic_photons)));
-        check("k_nearest", ok(limits::K_NEAREST.check(p.k_nearest)));
-        check("max_radius", ok(limits::LENGTH.check(p.max_radius)));
-        check("final_gather_rays", ok(limits::GATHER_RAYS.check(p.final_gather_rays)));
-        check("sppm_photons_per_pass", ok(limits::SPPM_PHOTONS.check(p.sppm_photons_per_pass)));
-        check("sppm_initial_radius", ok(limits::LENGTH.check(p.sppm_initial_radius)));
-        check("sppm_alpha", ok(limits::SPPM_ALPHA.check(p.sppm_alpha)));
+        match &self.method {
+            Method::Whitted | Method::Path => {}
+            Method::Photon(p) => {
+                check("global_photons", ok(limits::PHOTONS.check(p.global_photons)));
+                check("caustic_photons", ok(limits::PHOTONS.check(p.caustic_photons)));
+                check("k_nearest", ok(limits::K_NEAREST.check(p.k_nearest)));
+                check("max_radius", ok(limits::LENGTH.check(p.max_radius)));
+                check("final_gather_rays", ok(limits::GATHER_RAYS.check(p.final_gather_rays)));
+            }
+            Method::Sppm(p) => {
+                check("photons_per_pass", ok(limits::SPPM_PHOTONS.check(p.photons_per_pass)));
+                check("initial_radius", ok(limits::LENGTH.check(p.initial_radius)));
+                check("alpha", ok(limits::SPPM_ALPHA.check(p.alpha)));
+            }
+        }
         found
     }
 }
@@ -202,7 +282,7 @@ mod tests {
             threads: 100_000,
             tile_size: 0,
             time_limit: Some(f64::NAN),
-            photon: PhotonSettings { k_nearest: u32::MAX, ..PhotonSettings::default() },
+            method: Method::Photon(PhotonSettings { k_nearest: u32::MAX, ..PhotonSettings::default() }),
             ..RenderSettings::default()
         };
         let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();

@@ -18,7 +18,7 @@ use std::time::Duration;
 use rayon::prelude::*;
 
 use crate::render::film::{Film, FilmTile};
-use crate::render::settings::{Algorithm, RenderSettings};
+use crate::render::settings::{Method, RenderSettings};
 use crate::render::world::camera::{CameraModel, CameraTile, TileRect};
 use crate::render::world::rng::PassStreams;
 use crate::render::world::World;
@@ -121,15 +121,15 @@ impl Integrator {
         observer: &dyn PassObserver,
     ) -> Option<Self> {
         let settings = stage.settings;
-        Some(match settings.algorithm {
-            Algorithm::Whitted => Integrator::Whitted(whitted::Whitted { max_depth: settings.max_depth.max(1) }),
-            Algorithm::Path => Integrator::Path(path::PathTracer::new(stage.world, settings.max_depth)),
-            Algorithm::Photon => {
+        Some(match &settings.method {
+            Method::Whitted => Integrator::Whitted(whitted::Whitted { max_depth: settings.max_depth.max(1) }),
+            Method::Path => Integrator::Path(path::PathTracer::new(stage.world, settings.max_depth)),
+            Method::Photon(photon) => {
                 let maps = match maps {
                     Some(maps) => maps,
                     None => Arc::new(PhotonMaps::build(
                         stage.world,
-                        &settings.photon,
+                        photon,
                         settings.seed,
                         settings.max_depth,
                         visible_radius,
@@ -138,9 +138,9 @@ impl Integrator {
                 if !observer.is_current() {
                     return None;
                 }
-                Integrator::Photon(photon::PhotonMapping::new(maps, settings))
+                Integrator::Photon(photon::PhotonMapping::new(maps, photon, settings.max_depth))
             }
-            Algorithm::Sppm => Integrator::Sppm(sppm::Sppm::new(film, settings, visible_radius)),
+            Method::Sppm(sppm) => Integrator::Sppm(sppm::Sppm::new(film, sppm, settings, visible_radius)),
         })
     }
 

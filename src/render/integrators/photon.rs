@@ -12,7 +12,7 @@ use super::photon_map::kdtree::Neighbours;
 use super::photon_map::maps::{estimate, PhotonMaps, QueryStats};
 use super::{Counters, Stage};
 use crate::geometry::Ray;
-use crate::render::settings::{PhotonSettings, RenderSettings};
+use crate::render::settings::PhotonSettings;
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::rng::Sampler;
@@ -42,8 +42,8 @@ pub struct PhotonMapping {
 }
 
 impl PhotonMapping {
-    pub fn new(maps: Arc<PhotonMaps>, settings: &RenderSettings) -> Self {
-        Self { maps, settings: settings.photon.clone(), max_depth: settings.max_depth }
+    pub fn new(maps: Arc<PhotonMaps>, settings: &PhotonSettings, max_depth: u32) -> Self {
+        Self { maps, settings: settings.clone(), max_depth }
     }
 
     pub fn scratch(&self) -> PhotonScratch {

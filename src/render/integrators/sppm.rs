@@ -18,7 +18,7 @@ use super::photon_map::trace::{trace_photons, MapKind};
 use super::{Counters, PassObserver, PassReport, Stage};
 use crate::geometry::Ray;
 use crate::render::film::Film;
-use crate::render::settings::RenderSettings;
+use crate::render::settings::{RenderSettings, SppmSettings};
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::rng::Sampler;
@@ -38,15 +38,14 @@ pub struct Sppm {
 
 impl Sppm {
     /// The starting radius is the settings', or 2% of what the camera sees.
-    pub fn new(film: &Film, settings: &RenderSettings, visible_radius: f32) -> Self {
-        let p = &settings.photon;
+    pub fn new(film: &Film, sppm: &SppmSettings, settings: &RenderSettings, visible_radius: f32) -> Self {
         let initial_radius =
-            if p.sppm_initial_radius > 0.0 { p.sppm_initial_radius } else { (visible_radius * 0.02).max(1e-6) };
+            if sppm.initial_radius > 0.0 { sppm.initial_radius } else { (visible_radius * 0.02).max(1e-6) };
         Self {
             pixels: film.tiles.iter().map(|t| vec![SppmPixel::default(); t.sums.len()]).collect(),
             initial_radius,
-            photons_per_pass: p.sppm_photons_per_pass as u64,
-            alpha: p.sppm_alpha,
+            photons_per_pass: sppm.photons_per_pass as u64,
+            alpha: sppm.alpha,
             max_depth: settings.max_depth,
             seed: settings.seed,
         }
