@@ -34,14 +34,14 @@ fn render(scene: gi_studio::scene::Scene, algorithm: Algorithm, spp: u32) -> gi_
         samples_per_pixel: Some(spp),
         ..RenderSettings::for_algorithm(algorithm)
     };
-    render_blocking(&RenderJob::new(Arc::new(scene), settings)).expect("renders").0
+    render_blocking(&RenderJob::new(Arc::new(valid(scene)), settings)).expect("renders").0
 }
 
 #[test]
 fn lambert_plane_under_a_directional_light() {
     let direction = Vec3::new(0.3, -1.0, -0.5).normalize();
     let scene = floor_scene(0.6, vec![light("sun", LightKind::Directional { direction }, 2.0)]);
-    let world = World::new(&scene);
+    let world = World::new(&valid(scene.clone()));
     let expected = 0.6 / PI * 2.0 * (-direction).dot(Vec3::Y);
     for algorithm in [Algorithm::Path, Algorithm::Whitted] {
         for target in [Vec3::ZERO, Vec3::new(3.0, 0.0, -7.0), Vec3::new(-40.0, 0.0, 2.0)] {
@@ -56,7 +56,7 @@ fn lambert_plane_under_a_directional_light() {
 fn lambert_plane_under_a_point_light() {
     let position = Vec3::new(0.4, 1.5, -0.2);
     let scene = floor_scene(0.8, vec![light("bulb", LightKind::Point { position }, 5.0)]);
-    let world = World::new(&scene);
+    let world = World::new(&valid(scene.clone()));
     for target in [Vec3::ZERO, Vec3::new(1.0, 0.0, -1.0), Vec3::new(-3.0, 0.0, 0.5)] {
         let to_light = position - target;
         let d = to_light.length();
@@ -101,7 +101,7 @@ fn whitted_phong_sphere_matches_the_hand_computation() {
         vec![light("bulb", LightKind::Point { position: light_position }, 20.0)],
     );
     scene.ambient = Vec3::splat(0.1);
-    let world = World::new(&scene);
+    let world = World::new(&valid(scene.clone()));
     let camera = gi_studio::render::world::camera::CameraModel::new(&scene.camera, 64, 48);
     for (px, py) in [(32.0, 24.0), (36.5, 20.5), (28.0, 27.0), (34.0, 22.0)] {
         let ray = camera.pixel_ray(px, py);
@@ -135,7 +135,7 @@ fn spot_cone_edge_falls_where_cos_theta_says() {
         falloff_exponent: 0.0,
     };
     let scene = floor_scene(0.5, vec![light("spot", spot, 10.0)]);
-    let world = World::new(&scene);
+    let world = World::new(&valid(scene.clone()));
     let edge = height * cone.to_radians().tan();
     let origin = Vec3::new(0.0, 5.0, 0.01);
     for (radius, lit) in [(edge * 0.99, true), (edge * 1.01, false), (0.0, true), (edge * 2.0, false)] {
@@ -218,7 +218,7 @@ fn floor_under_a_light_poking_through_the_ceiling() {
 
     // The world samples exactly that cap: 1 − cos θ of the rim seen from the light's centre
     let camera = gi_studio::render::world::camera::CameraModel::new(&scene.camera, 32, 24);
-    let (world, _) = World::for_view(&scene, &camera, 32, 24);
+    let (world, _) = World::for_view(&valid(scene.clone()), &camera, 32, 24);
     let cap = world.emitting_cap(1);
     let expected_cap = 1.0 - (y_light - h) / radius;
     assert!(((cap.one_minus_cos as f64) - expected_cap).abs() < 1e-3 * expected_cap, "{cap:?} vs {expected_cap}");

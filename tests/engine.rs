@@ -1,6 +1,9 @@
 //! The progressive engine: determinism, restarts, and every preset rendering
 //! finite images with both algorithms.
 
+mod common;
+
+use common::valid;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -17,7 +20,7 @@ fn job(name: &str, algorithm: Algorithm, width: u32, height: u32, spp: u32, thre
         seed: 11,
         ..RenderSettings::for_algorithm(algorithm)
     };
-    RenderJob::new(Arc::new(scene), settings)
+    RenderJob::new(Arc::new(valid(scene)), settings)
 }
 
 #[test]
@@ -131,10 +134,12 @@ fn time_budget_stops_the_render() {
     assert!(stats.passes >= 1);
 }
 
+/// A scene reaches the engine only checked (`ValidScene`); settings out of
+/// their limits, which a driver could still send, fail instead of rendering.
 #[test]
-fn invalid_scene_fails_instead_of_rendering() {
+fn settings_out_of_their_limits_fail_instead_of_rendering() {
     let mut job = job("cornell", Algorithm::Path, 8, 8, 1, 0);
-    Arc::make_mut(&mut job.scene).objects[5].material = "nowhere".into();
+    job.settings.tile_size = 0;
     let error = render_blocking(&job).unwrap_err();
-    assert!(error.contains("nowhere"), "{error}");
+    assert!(error.starts_with("tile_size: must be between 4 and 512"), "{error}");
 }

@@ -4,6 +4,9 @@
 //! updates the hash here. (The hashes are of this machine's float
 //! arithmetic: x86-64, and the same on any thread count.)
 
+mod common;
+
+use common::valid;
 use std::sync::Arc;
 
 use gi_studio::render::{render_blocking, Algorithm, LinearImage, RenderJob, RenderSettings};
@@ -48,7 +51,7 @@ fn golden_render(preset: &str, algorithm: Algorithm) -> LinearImage {
         ..RenderSettings::for_algorithm(algorithm)
     };
     settings.set_photons(20_000);
-    render_blocking(&RenderJob::new(Arc::new(scene), settings)).unwrap().0
+    render_blocking(&RenderJob::new(Arc::new(valid(scene)), settings)).unwrap().0
 }
 
 #[test]

@@ -30,7 +30,7 @@ fn settings(algorithm: Algorithm, width: u32, height: u32, spp: u32) -> RenderSe
 }
 
 fn render(scene: &Scene, settings: RenderSettings) -> (LinearImage, u64) {
-    let (image, stats) = render_blocking(&RenderJob::new(Arc::new(scene.clone()), settings)).expect("renders");
+    let (image, stats) = render_blocking(&RenderJob::new(Arc::new(valid(scene.clone())), settings)).expect("renders");
     assert!(image.pixels.iter().flatten().all(|c| c.is_finite()), "a non-finite pixel reached the film");
     (image, stats.non_finite)
 }
@@ -40,7 +40,7 @@ fn render(scene: &Scene, settings: RenderSettings) -> (LinearImage, u64) {
 #[test]
 fn case_01_smallpt_walls_no_acne() {
     let scene = presets::preset("smallpt").unwrap().unwrap();
-    let world = World::new(&scene);
+    let world = World::new(&valid(scene.clone()));
     let camera = CameraModel::new(&scene.camera, 64, 48);
     let front = Vec3::new(50.0, 40.8, -99830.0);
     let mut s = Sampler::new(0, 0, 1);
@@ -92,7 +92,7 @@ fn case_03_distant_sphere_has_no_rings() {
         vec![light("sun", LightKind::Directional { direction: sun }, 1.0)],
     );
     scene.camera.fov_y_degrees = 15.0;
-    let world = World::new(&scene);
+    let world = World::new(&valid(scene.clone()));
     let camera = CameraModel::new(&scene.camera, 48, 48);
     let mut counters = Counters::default();
     for y in 0..48 {
@@ -646,7 +646,7 @@ fn case_17_sppm_thousands_of_passes() {
     let mut s = settings(Algorithm::Sppm, 4, 3, 2000);
     s.set_photons(500);
     let session = gi_studio::render::RenderSession::new(None).unwrap();
-    let generation = session.start(RenderJob::new(Arc::new(scene), s));
+    let generation = session.start(RenderJob::new(Arc::new(valid(scene)), s));
     let mut last_radius = f32::INFINITY;
     for event in session.events().iter() {
         match event {

@@ -10,20 +10,22 @@ use gi_studio::render::world::camera::CameraTile;
 use gi_studio::render::world::camera::TileRect;
 use gi_studio::render::world::rng::PassStreams;
 use gi_studio::render::world::World;
-use gi_studio::scene::{presets, Attenuation, Light, LightKind, MaterialModel, Rgb, Scene};
+use gi_studio::scene::{presets, Attenuation, Light, LightKind, MaterialModel, Rgb, Scene, ValidScene};
 use glam::Vec3;
 
 fn light(kind: LightKind, intensity: f32) -> Light {
-    Light { name: "extra".into(), kind, color: Rgb::ONE, intensity, attenuation: Attenuation::default(), enabled: true }
+    let name = format!("extra {}", kind.kind_name());
+    Light { name, kind, color: Rgb::ONE, intensity, attenuation: Attenuation::default(), enabled: true }
 }
 
 fn preset(name: &str) -> Scene {
-    presets::preset(name).and_then(Result::ok).expect("preset")
+    presets::preset(name).and_then(Result::ok).expect("preset").into_scene()
 }
 
 fn world(scene: &Scene, width: u32, height: u32) -> (World, CameraModel) {
     let camera = CameraModel::new(&scene.camera, width, height);
-    let (world, _) = World::for_view(scene, &camera, width, height);
+    let valid = ValidScene::new(scene.clone()).expect("a valid scene");
+    let (world, _) = World::for_view(&valid, &camera, width, height);
     (world, camera)
 }
 

@@ -27,12 +27,12 @@ fn settings(algorithm: Algorithm, width: u32, height: u32, spp: u32) -> RenderSe
 }
 
 fn render(scene: &Scene, settings: RenderSettings) -> LinearImage {
-    render_blocking(&RenderJob::new(Arc::new(scene.clone()), settings)).expect("renders").0
+    render_blocking(&RenderJob::new(Arc::new(valid(scene.clone())), settings)).expect("renders").0
 }
 
 /// A Cornell box with the mirror and glass balls made diffuse.
 fn diffuse_cornell() -> Scene {
-    let mut scene = presets::preset("cornell").unwrap().unwrap();
+    let mut scene = presets::preset("cornell").unwrap().unwrap().into_scene();
     for material in &mut scene.materials {
         if matches!(material.model, MaterialModel::Mirror { .. } | MaterialModel::Glass { .. }) {
             material.model = MaterialModel::Lambert { albedo: Vec3::splat(0.6) };
@@ -46,7 +46,7 @@ fn photons_on_a_plane_carry_the_analytic_share_of_a_point_lights_power() {
     let (height, intensity, radius) = (2.0f32, 3.0f32, 1.5f32);
     let scene =
         floor_scene(0.0, vec![light("bulb", LightKind::Point { position: Vec3::new(0.0, height, 0.0) }, intensity)]);
-    let world = World::new(&scene);
+    let world = World::new(&valid(scene.clone()));
     let photons = trace_photons(&world, MapKind::All, 400_000, 0, 1, 4);
     let within: f64 = photons
         .iter()
@@ -97,7 +97,7 @@ fn sppm_error_keeps_falling() {
     let mut sppm = settings(Algorithm::Sppm, 40, 30, 64);
     sppm.set_photons(20_000);
     let session = RenderSession::new(None).unwrap();
-    let generation = session.start(RenderJob::new(Arc::new(scene), sppm));
+    let generation = session.start(RenderJob::new(Arc::new(valid(scene)), sppm));
     let mut errors = Vec::new();
     let mut current = LinearImage::new(40, 30);
     for event in session.events().iter() {
@@ -156,7 +156,7 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
     let mut s = settings(Algorithm::Photon, 32, 24, 2);
     s.set_photons(20_000);
     let camera = CameraModel::new(&scene.camera, s.width, s.height);
-    let (world, visible) = World::for_view(&scene, &camera, s.width, s.height);
+    let (world, visible) = World::for_view(&valid(scene.clone()), &camera, s.width, s.height);
     let maps = PhotonMaps::build(&world, s.photon().unwrap(), s.seed, s.max_depth, visible);
     let dir = std::env::temp_dir().join(format!("gi-pmap-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -165,11 +165,11 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
     save_photon_maps(&maps, scene_key, key, &path).unwrap();
 
     let fresh = render(&scene, s.clone());
-    let mut job = RenderJob::new(Arc::new(scene.clone()), s.clone());
+    let mut job = RenderJob::new(Arc::new(valid(scene.clone())), s.clone());
     job.photon_maps = Some(Arc::new(load_photon_maps(&path, scene_key, key).unwrap()));
     assert_eq!(render_blocking(&job).unwrap().0, fresh);
 
-    let mut other_scene = scene.clone();
+    let mut other_scene = scene.clone().into_scene();
     other_scene.objects[2].name = "renamed ball".into();
     assert!(matches!(load_photon_maps(&path, other_scene.content_key(), key), Err(PhotonFileError::OtherScene { .. })));
     let mut other = s.photon().unwrap().clone();
@@ -204,7 +204,7 @@ fn damaged_photon_maps_are_refused_each_with_its_own_message() {
     let mut s = settings(Algorithm::Photon, 32, 24, 1);
     s.set_photons(2_000);
     let camera = CameraModel::new(&scene.camera, s.width, s.height);
-    let (world, visible) = World::for_view(&scene, &camera, s.width, s.height);
+    let (world, visible) = World::for_view(&valid(scene.clone()), &camera, s.width, s.height);
     let maps = PhotonMaps::build(&world, s.photon().unwrap(), s.seed, s.max_depth, visible);
     assert!(maps.global.len() > 100);
     let dir = std::env::temp_dir().join(format!("gi-pmap-damage-{}", std::process::id()));
@@ -270,7 +270,7 @@ fn a_light_larger_than_the_scene_delivers_the_right_power() {
     let mut s = settings(Algorithm::Sppm, reference.width, reference.height, 64);
     s.set_photons(50_000);
     let session = RenderSession::new(None).unwrap();
-    let generation = session.start(RenderJob::new(Arc::new(scene), s));
+    let generation = session.start(RenderJob::new(Arc::new(valid(scene)), s));
     let mut image = LinearImage::new(reference.width, reference.height);
     let mut errors = Vec::new();
     for event in session.events().iter() {

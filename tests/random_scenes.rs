@@ -114,8 +114,9 @@ proptest! {
         prop_assume!(scene.validate().is_empty());
         // The text form round-trips too
         let text = to_ron(&scene).unwrap();
-        prop_assert_eq!(&parse_scene(&text, std::path::Path::new("random.ron")).unwrap(), &scene);
-        let scene = Arc::new(scene);
+        let parsed = parse_scene(&text, std::path::Path::new("random.ron")).unwrap();
+        prop_assert_eq!(&*parsed, &scene);
+        let scene = Arc::new(parsed);
         for algorithm in Algorithm::ALL {
             let mut settings = RenderSettings { width: 8, height: 6, samples_per_pixel: Some(2), preview: true, ..RenderSettings::for_algorithm(algorithm) };
             settings.set_photons(500);

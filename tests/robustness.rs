@@ -4,6 +4,9 @@
 //! so an unbounded allocation aborts the child and fails the test on any
 //! machine, however much memory it has.
 
+mod common;
+
+use common::valid;
 use std::path::Path;
 use std::process::Command;
 use std::sync::Arc;
@@ -11,7 +14,7 @@ use std::sync::Arc;
 use clap::Parser;
 use gi_studio::cli::{Command as Cli, Headless};
 use gi_studio::render::{render_blocking, Algorithm, RenderJob, RenderSettings};
-use gi_studio::scene::{parse_scene, presets, Scene};
+use gi_studio::scene::{parse_scene, presets, ValidScene};
 use proptest::prelude::*;
 
 const CHILD: &str = "GI_STUDIO_ROBUSTNESS_CHILD";
@@ -166,7 +169,7 @@ fn apply(text: &str, mutation: &Mutation) -> String {
 }
 
 /// A scene that loads renders: a tiny image, finite and not negative.
-fn render_tiny(scene: Scene, algorithm: Algorithm) {
+fn render_tiny(scene: ValidScene, algorithm: Algorithm) {
     let mut settings = RenderSettings {
         width: 8,
         height: 6,
@@ -175,7 +178,7 @@ fn render_tiny(scene: Scene, algorithm: Algorithm) {
         ..RenderSettings::for_algorithm(algorithm)
     };
     settings.set_photons(200);
-    let (image, _) = render_blocking(&RenderJob::new(Arc::new(scene), settings)).expect("a valid scene renders");
+    let (image, _) = render_blocking(&RenderJob::new(Arc::new(valid(scene)), settings)).expect("a valid scene renders");
     assert!(image.pixels.iter().flatten().all(|c| c.is_finite() && *c >= 0.0), "{algorithm}");
 }
 

@@ -37,6 +37,36 @@ impl ScreenshotRequest {
     }
 }
 
+impl ScreenshotRequest {
+    /// Advance one frame: wait out the delay, ask egui for the image once
+    /// `ready`, and give the outcome once it is saved.
+    pub fn step(&mut self, ctx: &egui::Context, ready: bool) -> Option<Result<PathBuf, String>> {
+        if !self.requested {
+            if self.delay > 0 {
+                self.delay -= 1;
+            } else if ready {
+                self.requested = true;
+                let (path, crop, result, repaint) = (self.path.clone(), self.crop, self.result.clone(), ctx.clone());
+                let pixels_per_point = ctx.pixels_per_point();
+                ctx.request_screenshot(move |image| {
+                    let outcome = save_screenshot(&image, crop, pixels_per_point, &path);
+                    if let Ok(mut slot) = result.lock() {
+                        *slot = Some(outcome);
+                    }
+                    repaint.request_repaint();
+                });
+            }
+            ctx.request_repaint();
+            return None;
+        }
+        let outcome = self.result.lock().ok().and_then(|mut slot| slot.take());
+        if outcome.is_none() {
+            ctx.request_repaint();
+        }
+        outcome.map(|saved| saved.map(|()| self.path.clone()))
+    }
+}
+
 /// `--screenshot PATH` checked before the window opens: a PNG, in a folder
 /// that exists, not replacing a file GI Studio did not write (unless forced).
 pub fn check_screenshot_path(path: &Path, force: bool) -> Result<()> {

@@ -1,27 +1,28 @@
-//! Undo and redo over scene snapshots. A change is committed once the user
-//! lets go (no drag in progress), so one drag of a slider is one step.
+//! Undo and redo over scene snapshots, each with its revision (so undoing
+//! back to the saved state is clean again). A change is committed once the
+//! user lets go (no drag in progress), so one drag of a slider is one step.
 
 use crate::scene::Scene;
 
 pub struct History {
-    undo: Vec<Scene>,
-    redo: Vec<Scene>,
-    committed: Scene,
+    undo: Vec<(Scene, u64)>,
+    redo: Vec<(Scene, u64)>,
+    committed: (Scene, u64),
 }
 
 /// Enough for a session of edits; snapshots are small.
 const LIMIT: usize = 500;
 
 impl History {
-    pub fn new(scene: &Scene) -> Self {
-        Self { undo: Vec::new(), redo: Vec::new(), committed: scene.clone() }
+    pub fn new(scene: &Scene, revision: u64) -> Self {
+        Self { undo: Vec::new(), redo: Vec::new(), committed: (scene.clone(), revision) }
     }
 
-    /// Record `scene` as a new step if it differs from the last one and the
-    /// user is not in the middle of a drag.
-    pub fn observe(&mut self, scene: &Scene, interacting: bool) {
-        if !interacting && *scene != self.committed {
-            self.undo.push(std::mem::replace(&mut self.committed, scene.clone()));
+    /// Record `scene` as a new step if its revision is new and the user is
+    /// not in the middle of a drag.
+    pub fn observe(&mut self, scene: &Scene, revision: u64, interacting: bool) {
+        if !interacting && revision != self.committed.1 {
+            self.undo.push(std::mem::replace(&mut self.committed, (scene.clone(), revision)));
             if self.undo.len() > LIMIT {
                 self.undo.remove(0);
             }
@@ -37,18 +38,19 @@ impl History {
         !self.redo.is_empty()
     }
 
-    pub fn undo(&mut self, scene: &mut Scene) {
-        self.observe(scene, false);
+    /// Step back: `scene` and `revision` become the previous step's.
+    pub fn undo(&mut self, scene: &mut Scene, revision: &mut u64) {
+        self.observe(scene, *revision, false);
         if let Some(previous) = self.undo.pop() {
             self.redo.push(std::mem::replace(&mut self.committed, previous.clone()));
-            *scene = previous;
+            (*scene, *revision) = previous;
         }
     }
 
-    pub fn redo(&mut self, scene: &mut Scene) {
+    pub fn redo(&mut self, scene: &mut Scene, revision: &mut u64) {
         if let Some(next) = self.redo.pop() {
             self.undo.push(std::mem::replace(&mut self.committed, next.clone()));
-            *scene = next;
+            (*scene, *revision) = next;
         }
     }
 }
@@ -59,21 +61,23 @@ mod tests {
     use crate::scene::presets::default_scene;
 
     #[test]
-    fn a_drag_is_one_step_and_undo_redo_walk_it() {
+    fn a_drag_is_one_step_and_undo_redo_walk_it_with_its_revisions() {
         let original = default_scene();
         let mut scene = original.clone();
-        let mut history = History::new(&scene);
+        let mut revision = 1;
+        let mut history = History::new(&scene, revision);
         for step in 1..=10 {
             scene.camera.fov_y_degrees = 40.0 + step as f32;
-            history.observe(&scene, true);
+            revision += 1;
+            history.observe(&scene, revision, true);
         }
-        history.observe(&scene, false);
-        let dragged = scene.clone();
-        history.undo(&mut scene);
-        assert_eq!(scene, original);
+        history.observe(&scene, revision, false);
+        let (dragged, dragged_revision) = (scene.clone(), revision);
+        history.undo(&mut scene, &mut revision);
+        assert_eq!((&scene, revision), (&original, 1));
         assert!(!history.can_undo());
-        history.redo(&mut scene);
-        assert_eq!(scene, dragged);
+        history.redo(&mut scene, &mut revision);
+        assert_eq!((&scene, revision), (&dragged, dragged_revision));
         assert!(!history.can_redo());
     }
 }

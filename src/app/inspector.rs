@@ -17,7 +17,8 @@ pub enum Selection {
     Light(usize),
 }
 
-pub fn inspector_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection, problems: &[Invalid]) {
+/// Draw the inspector; returns whether the scene changed.
+pub fn inspector_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection, problems: &[Invalid]) -> bool {
     if !problems.is_empty() {
         egui::Frame::new().fill(ui.visuals().extreme_bg_color).inner_margin(6.0).show(ui, |ui| {
             ui.colored_label(ui.visuals().error_fg_color, "Not rendered until fixed:");
@@ -26,13 +27,16 @@ pub fn inspector_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Select
             }
         });
     }
-    egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
-        ui.selectable_value(selection, Selection::Camera, "Camera");
-        list_ui(ui, "Objects", scene, selection);
-        ui.separator();
-        ui.heading(selected_title(scene, *selection));
-        properties_ui(ui, scene, selection);
-    });
+    egui::ScrollArea::vertical()
+        .auto_shrink([false, false])
+        .show(ui, |ui| {
+            ui.selectable_value(selection, Selection::Camera, "Camera");
+            let listed = list_ui(ui, scene, selection);
+            ui.separator();
+            ui.heading(selected_title(scene, *selection));
+            listed | properties_ui(ui, scene, selection)
+        })
+        .inner
 }
 
 fn selected_title(scene: &Scene, selection: Selection) -> String {
@@ -48,7 +52,10 @@ fn unique_name(base: &str, taken: impl Fn(&str) -> bool) -> String {
     (1..).map(|n| if n == 1 { base.to_owned() } else { format!("{base} {n}") }).find(|n| !taken(n)).unwrap_or_default()
 }
 
-fn list_ui(ui: &mut egui::Ui, _title: &str, scene: &mut Scene, selection: &mut Selection) {
+/// The lists with their add, duplicate and delete buttons.
+fn list_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection) -> bool {
+    let before = (scene.objects.len(), scene.materials.len(), scene.lights.len());
+    let mut toggled = false;
     egui::CollapsingHeader::new("Objects").default_open(true).show(ui, |ui| {
         for (i, object) in scene.objects.iter().enumerate() {
             ui.selectable_value(
@@ -125,7 +132,9 @@ fn list_ui(ui: &mut egui::Ui, _title: &str, scene: &mut Scene, selection: &mut S
     egui::CollapsingHeader::new("Lights").default_open(true).show(ui, |ui| {
         for (i, light) in scene.lights.iter_mut().enumerate() {
             ui.horizontal(|ui| {
-                ui.checkbox(&mut light.enabled, "").on_hover_text("Enabled").widget_info(|| {
+                let checkbox = ui.checkbox(&mut light.enabled, "");
+                toggled |= checkbox.changed();
+                checkbox.on_hover_text("Enabled").widget_info(|| {
                     egui::WidgetInfo::selected(
                         egui::Role::CheckBox,
                         true,
@@ -169,6 +178,8 @@ fn list_ui(ui: &mut egui::Ui, _title: &str, scene: &mut Scene, selection: &mut S
             }
         });
     });
+    // One click a frame: an add, a duplicate or a delete changes a count
+    toggled || (scene.objects.len(), scene.materials.len(), scene.lights.len()) != (before.0, before.1, before.2)
 }
 
 fn shape_name(shape: &Shape) -> &'static str {
@@ -179,99 +190,114 @@ fn shape_name(shape: &Shape) -> &'static str {
     }
 }
 
-fn vec3_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f64) {
+// Every widget function returns whether it changed the scene: the studio
+// counts revisions by it instead of comparing the scene each frame.
+
+fn vec3_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f64) -> bool {
     ui.horizontal(|ui| {
         let label = ui.label(label);
+        let mut changed = false;
         for (axis, c) in ["x", "y", "z"].into_iter().zip([&mut v.x, &mut v.y, &mut v.z]) {
-            ui.add(egui::DragValue::new(c).speed(speed).prefix(format!("{axis} "))).labelled_by(label.id);
+            changed |=
+                ui.add(egui::DragValue::new(c).speed(speed).prefix(format!("{axis} "))).labelled_by(label.id).changed();
         }
-    });
+        changed
+    })
+    .inner
 }
 
-fn scalar_ui(ui: &mut egui::Ui, label: &str, v: &mut f32, range: std::ops::RangeInclusive<f32>, speed: f64) {
+fn scalar_ui(ui: &mut egui::Ui, label: &str, v: &mut f32, range: std::ops::RangeInclusive<f32>, speed: f64) -> bool {
     ui.horizontal(|ui| {
         let label = ui.label(label);
-        ui.add(egui::DragValue::new(v).speed(speed).range(range)).labelled_by(label.id);
-    });
+        ui.add(egui::DragValue::new(v).speed(speed).range(range)).labelled_by(label.id).changed()
+    })
+    .inner
 }
 
 /// A reflectance in [0, 1]: a colour picker.
-fn reflectance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) {
+fn reflectance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) -> bool {
     ui.horizontal(|ui| {
         let label = ui.label(label);
         let mut rgb = v.to_array();
+        let mut changed = false;
         if ui.color_edit_button_rgb(&mut rgb).labelled_by(label.id).changed() {
             *v = Vec3::from_array(rgb).clamp(Vec3::ZERO, Vec3::ONE);
+            changed = true;
         }
         for c in [&mut v.x, &mut v.y, &mut v.z] {
-            ui.add(egui::DragValue::new(c).speed(0.005).range(0.0..=1.0)).labelled_by(label.id);
+            changed |= ui.add(egui::DragValue::new(c).speed(0.005).range(0.0..=1.0)).labelled_by(label.id).changed();
         }
-    });
+        changed
+    })
+    .inner
 }
 
 /// Radiance or power: unbounded above, never negative.
-fn radiance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) {
+fn radiance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) -> bool {
     ui.horizontal(|ui| {
         let label = ui.label(label);
+        let mut changed = false;
         for c in [&mut v.x, &mut v.y, &mut v.z] {
-            ui.add(egui::DragValue::new(c).speed(0.05).range(0.0..=f32::MAX)).labelled_by(label.id);
+            changed |=
+                ui.add(egui::DragValue::new(c).speed(0.05).range(0.0..=f32::MAX)).labelled_by(label.id).changed();
         }
-    });
+        changed
+    })
+    .inner
 }
 
-fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection) {
+fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection) -> bool {
+    let mut changed = false;
     match *selection {
         Selection::Camera => {
             let camera = &mut scene.camera;
-            vec3_ui(ui, "Position", &mut camera.position, 0.01);
-            vec3_ui(ui, "Look at", &mut camera.look_at, 0.01);
-            vec3_ui(ui, "Up", &mut camera.up, 0.01);
-            ui.add(egui::Slider::new(&mut camera.fov_y_degrees, 1.0..=170.0).text("Field of view °"));
-            scalar_ui(ui, "Near clip", &mut camera.near_clip, 0.0..=f32::MAX, 0.01);
-            scalar_ui(ui, "Aperture radius", &mut camera.aperture_radius, 0.0..=f32::MAX, 0.001);
-            scalar_ui(ui, "Focus distance (0: look-at)", &mut camera.focus_distance, 0.0..=f32::MAX, 0.01);
-            radiance_ui(ui, "Background", &mut scene.background);
-            radiance_ui(ui, "Ambient (Whitted)", &mut scene.ambient);
+            changed |= vec3_ui(ui, "Position", &mut camera.position, 0.01);
+            changed |= vec3_ui(ui, "Look at", &mut camera.look_at, 0.01);
+            changed |= vec3_ui(ui, "Up", &mut camera.up, 0.01);
+            changed |=
+                ui.add(egui::Slider::new(&mut camera.fov_y_degrees, 1.0..=170.0).text("Field of view °")).changed();
+            changed |= scalar_ui(ui, "Near clip", &mut camera.near_clip, 0.0..=f32::MAX, 0.01);
+            changed |= scalar_ui(ui, "Aperture radius", &mut camera.aperture_radius, 0.0..=f32::MAX, 0.001);
+            changed |= scalar_ui(ui, "Focus distance (0: look-at)", &mut camera.focus_distance, 0.0..=f32::MAX, 0.01);
+            changed |= radiance_ui(ui, "Background", &mut scene.background);
+            changed |= radiance_ui(ui, "Ambient (Whitted)", &mut scene.ambient);
         }
         Selection::Object(i) => {
             let names: Vec<String> = scene.materials.iter().map(|m| m.name.clone()).collect();
-            let Some(object) = scene.objects.get_mut(i) else { return };
-            ui.horizontal(|ui| {
-                ui.label("Name");
-                ui.text_edit_singleline(&mut object.name);
-            });
+            let Some(object) = scene.objects.get_mut(i) else { return false };
+            changed |= name_ui(ui, &mut object.name);
             egui::ComboBox::from_label("Material").selected_text(object.material.clone()).show_ui(ui, |ui| {
                 for name in names {
-                    ui.selectable_value(&mut object.material, name.clone(), name);
+                    changed |= ui.selectable_value(&mut object.material, name.clone(), name).changed();
                 }
             });
             match &mut object.shape {
                 Shape::Sphere { center, radius } => {
-                    vec3_ui(ui, "Centre", center, 0.01);
-                    ui.horizontal(|ui| {
-                        let label = ui.label("Radius");
-                        ui.add(egui::DragValue::new(radius).speed(0.01).range(1e-6..=f32::MAX)).labelled_by(label.id);
-                    });
+                    changed |= vec3_ui(ui, "Centre", center, 0.01);
+                    changed |= ui
+                        .horizontal(|ui| {
+                            let label = ui.label("Radius");
+                            let drag = egui::DragValue::new(radius).speed(0.01).range(1e-6..=f32::MAX);
+                            ui.add(drag).labelled_by(label.id).changed()
+                        })
+                        .inner;
                 }
                 Shape::Plane { point, normal } => {
-                    vec3_ui(ui, "Point", point, 0.01);
-                    vec3_ui(ui, "Normal", normal, 0.01);
+                    changed |= vec3_ui(ui, "Point", point, 0.01);
+                    changed |= vec3_ui(ui, "Normal", normal, 0.01);
                 }
                 Shape::Triangle { a, b, c } => {
-                    vec3_ui(ui, "A", a, 0.01);
-                    vec3_ui(ui, "B", b, 0.01);
-                    vec3_ui(ui, "C", c, 0.01);
+                    changed |= vec3_ui(ui, "A", a, 0.01);
+                    changed |= vec3_ui(ui, "B", b, 0.01);
+                    changed |= vec3_ui(ui, "C", c, 0.01);
                 }
             }
         }
         Selection::Material(i) => {
-            let Some(material) = scene.materials.get_mut(i) else { return };
+            let Some(material) = scene.materials.get_mut(i) else { return false };
             let old_name = material.name.clone();
-            ui.horizontal(|ui| {
-                ui.label("Name");
-                ui.text_edit_singleline(&mut material.name);
-            });
-            material_model_ui(ui, &mut material.model);
+            changed |= name_ui(ui, &mut material.name);
+            changed |= material_model_ui(ui, &mut material.model);
             // Renaming a material keeps its objects pointing at it
             let new_name = material.name.clone();
             if new_name != old_name {
@@ -281,30 +307,37 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
             }
         }
         Selection::Light(i) => {
-            let Some(light) = scene.lights.get_mut(i) else { return };
-            ui.horizontal(|ui| {
-                ui.label("Name");
-                ui.text_edit_singleline(&mut light.name);
-            });
-            ui.checkbox(&mut light.enabled, "Enabled");
-            light_kind_ui(ui, &mut light.kind);
-            reflectance_ui(ui, "Colour", &mut light.color);
-            scalar_ui(ui, "Intensity", &mut light.intensity, 0.0..=f32::MAX, 0.1);
+            let Some(light) = scene.lights.get_mut(i) else { return false };
+            changed |= name_ui(ui, &mut light.name);
+            changed |= ui.checkbox(&mut light.enabled, "Enabled").changed();
+            changed |= light_kind_ui(ui, &mut light.kind);
+            changed |= reflectance_ui(ui, "Colour", &mut light.color);
+            changed |= scalar_ui(ui, "Intensity", &mut light.intensity, 0.0..=f32::MAX, 0.1);
             if !matches!(light.kind, LightKind::Directional { .. }) {
                 let heading = ui.label("Attenuation 1/(a·d² + b·d + c)");
                 ui.horizontal(|ui| {
                     let a = &mut light.attenuation;
                     for (label, v) in [("a", &mut a.a), ("b", &mut a.b), ("c", &mut a.c)] {
-                        ui.add(egui::DragValue::new(v).speed(0.01).range(0.0..=f32::MAX).prefix(format!("{label} ")))
-                            .labelled_by(heading.id);
+                        let drag =
+                            egui::DragValue::new(v).speed(0.01).range(0.0..=f32::MAX).prefix(format!("{label} "));
+                        changed |= ui.add(drag).labelled_by(heading.id).changed();
                     }
                 });
             }
         }
     }
+    changed
 }
 
-fn material_model_ui(ui: &mut egui::Ui, model: &mut MaterialModel) {
+fn name_ui(ui: &mut egui::Ui, name: &mut String) -> bool {
+    ui.horizontal(|ui| {
+        ui.label("Name");
+        ui.text_edit_singleline(name).changed()
+    })
+    .inner
+}
+
+fn material_model_ui(ui: &mut egui::Ui, model: &mut MaterialModel) -> bool {
     let (kd, ks) = match model {
         MaterialModel::Lambert { albedo } => (*albedo, Vec3::ZERO),
         MaterialModel::Phong { kd, ks, .. } | MaterialModel::BlinnPhong { kd, ks, .. } => (*kd, *ks),
@@ -319,33 +352,37 @@ fn material_model_ui(ui: &mut egui::Ui, model: &mut MaterialModel) {
         MaterialModel::Glass { ior: 1.5, tint: Vec3::ONE },
         MaterialModel::Emissive { radiance: Vec3::splat(5.0) },
     ];
+    let mut changed = false;
     egui::ComboBox::from_label("Model").selected_text(model.kind_name()).show_ui(ui, |ui| {
         for choice in choices {
             if ui.selectable_label(choice.kind_name() == model.kind_name(), choice.kind_name()).clicked()
                 && choice.kind_name() != model.kind_name()
             {
                 *model = choice;
+                changed = true;
             }
         }
     });
-    match model {
-        MaterialModel::Lambert { albedo } => reflectance_ui(ui, "Albedo", albedo),
-        MaterialModel::Phong { ka, kd, ks, shininess } | MaterialModel::BlinnPhong { ka, kd, ks, shininess } => {
-            reflectance_ui(ui, "ka", ka);
-            reflectance_ui(ui, "kd", kd);
-            reflectance_ui(ui, "ks", ks);
-            ui.add(egui::Slider::new(shininess, 0.0..=2000.0).logarithmic(true).text("Shininess"));
+    changed
+        | match model {
+            MaterialModel::Lambert { albedo } => reflectance_ui(ui, "Albedo", albedo),
+            MaterialModel::Phong { ka, kd, ks, shininess } | MaterialModel::BlinnPhong { ka, kd, ks, shininess } => {
+                let mut changed = reflectance_ui(ui, "ka", ka);
+                changed |= reflectance_ui(ui, "kd", kd);
+                changed |= reflectance_ui(ui, "ks", ks);
+                let slider = egui::Slider::new(shininess, 0.0..=2000.0).logarithmic(true).text("Shininess");
+                changed | ui.add(slider).changed()
+            }
+            MaterialModel::Mirror { tint } => reflectance_ui(ui, "Tint", tint),
+            MaterialModel::Glass { ior, tint } => {
+                let changed = ui.add(egui::Slider::new(ior, 1.0..=3.0).text("Index of refraction")).changed();
+                changed | reflectance_ui(ui, "Tint", tint)
+            }
+            MaterialModel::Emissive { radiance } => radiance_ui(ui, "Radiance", radiance),
         }
-        MaterialModel::Mirror { tint } => reflectance_ui(ui, "Tint", tint),
-        MaterialModel::Glass { ior, tint } => {
-            ui.add(egui::Slider::new(ior, 1.0..=3.0).text("Index of refraction"));
-            reflectance_ui(ui, "Tint", tint);
-        }
-        MaterialModel::Emissive { radiance } => radiance_ui(ui, "Radiance", radiance),
-    }
 }
 
-fn light_kind_ui(ui: &mut egui::Ui, kind: &mut LightKind) {
+fn light_kind_ui(ui: &mut egui::Ui, kind: &mut LightKind) -> bool {
     let (position, direction) = match kind {
         LightKind::Point { position } => (*position, Vec3::NEG_Y),
         LightKind::Directional { direction } => (Vec3::new(0.0, 3.0, 0.0), *direction),
@@ -356,23 +393,28 @@ fn light_kind_ui(ui: &mut egui::Ui, kind: &mut LightKind) {
         LightKind::Directional { direction },
         LightKind::Spot { position, direction, cone_angle_degrees: 30.0, falloff_exponent: 2.0 },
     ];
+    let mut changed = false;
     egui::ComboBox::from_label("Type").selected_text(kind.kind_name()).show_ui(ui, |ui| {
         for choice in choices {
             if ui.selectable_label(choice.kind_name() == kind.kind_name(), choice.kind_name()).clicked()
                 && choice.kind_name() != kind.kind_name()
             {
                 *kind = choice;
+                changed = true;
             }
         }
     });
-    match kind {
-        LightKind::Point { position } => vec3_ui(ui, "Position", position, 0.01),
-        LightKind::Directional { direction } => vec3_ui(ui, "Direction", direction, 0.01),
-        LightKind::Spot { position, direction, cone_angle_degrees, falloff_exponent } => {
-            vec3_ui(ui, "Position", position, 0.01);
-            vec3_ui(ui, "Direction", direction, 0.01);
-            ui.add(egui::Slider::new(cone_angle_degrees, 0.1..=90.0).text("Cone half-angle °"));
-            ui.add(egui::Slider::new(falloff_exponent, 0.0..=10_000.0).logarithmic(true).text("Falloff exponent"));
+    changed
+        | match kind {
+            LightKind::Point { position } => vec3_ui(ui, "Position", position, 0.01),
+            LightKind::Directional { direction } => vec3_ui(ui, "Direction", direction, 0.01),
+            LightKind::Spot { position, direction, cone_angle_degrees, falloff_exponent } => {
+                let mut changed = vec3_ui(ui, "Position", position, 0.01);
+                changed |= vec3_ui(ui, "Direction", direction, 0.01);
+                changed |=
+                    ui.add(egui::Slider::new(cone_angle_degrees, 0.1..=90.0).text("Cone half-angle °")).changed();
+                let falloff = egui::Slider::new(falloff_exponent, 0.0..=10_000.0).logarithmic(true);
+                changed | ui.add(falloff.text("Falloff exponent")).changed()
+            }
         }
-    }
 }

@@ -1,93 +1,59 @@
-//! The menu bar: File, Edit, View, Help.
+//! The menu bar: File, Edit, View, Help. It reads a view of the studio and
+//! returns what the user chose as commands.
+
+use std::path::{Path, PathBuf};
 
 use eframe::egui;
 
+use super::commands::{Action, Command, Panel};
 use super::files::DialogPurpose;
-use super::studio::{Action, StudioApp};
 use crate::scene::presets;
 
-pub fn menu_bar_ui(ui: &mut egui::Ui, app: &mut StudioApp) {
+/// What the menus show.
+pub struct MenuView<'a> {
+    pub can_undo: bool,
+    pub can_redo: bool,
+    pub recent: &'a [PathBuf],
+    pub panes: usize,
+    pub plots: bool,
+    pub difference: bool,
+    pub debug: bool,
+    /// The document's file, and whether it has unsaved edits.
+    pub file: Option<(&'a Path, bool)>,
+}
+
+pub fn menu_bar_ui(ui: &mut egui::Ui, view: &MenuView, commands: &mut Vec<Command>) {
     egui::MenuBar::new().ui(ui, |ui| {
-        ui.menu_button("File", |ui| {
-            ui.menu_button("New from preset", |ui| {
-                for name in presets::names() {
-                    if ui.button(name).clicked() {
-                        app.request(Action::NewFromPreset(name.to_owned()));
-                        ui.close();
-                    }
-                }
-            });
-            if ui.button("Open…").clicked() {
-                app.open_dialog(DialogPurpose::OpenScene);
-                ui.close();
-            }
-            ui.menu_button("Open recent", |ui| {
-                if app.recent.is_empty() {
-                    ui.weak("Nothing yet");
-                }
-                for path in app.recent.clone() {
-                    if ui.button(path.display().to_string()).clicked() {
-                        app.request(Action::Open(path));
-                        ui.close();
-                    }
-                }
-            });
-            if ui.add(egui::Button::new("Save").shortcut_text("Ctrl+S")).clicked() {
-                app.save_or_ask();
-                ui.close();
-            }
-            if ui.button("Save as…").clicked() {
-                app.open_dialog(DialogPurpose::SaveScene);
-                ui.close();
-            }
-            ui.menu_button("Export image", |ui| {
-                if ui.button("PNG (display)…").clicked() {
-                    app.open_dialog(DialogPurpose::ExportPng);
-                    ui.close();
-                }
-                if ui.button("EXR (linear)…").clicked() {
-                    app.open_dialog(DialogPurpose::ExportExr);
-                    ui.close();
-                }
-            });
-            if ui.button("Save window screenshot…").clicked() {
-                app.open_dialog(DialogPurpose::Screenshot);
-                ui.close();
-            }
-            if ui.button("Export comparison sheet…").clicked() {
-                app.open_dialog(DialogPurpose::ComparisonSheet);
-                ui.close();
-            }
-            ui.separator();
-            if ui.button("Quit").clicked() {
-                app.request(Action::Quit);
-                ui.close();
-            }
-        });
+        ui.menu_button("File", |ui| file_menu_ui(ui, view, commands));
         ui.menu_button("Edit", |ui| {
-            if ui.add_enabled(app.can_undo(), egui::Button::new("Undo").shortcut_text("Ctrl+Z")).clicked() {
-                app.undo();
+            if ui.add_enabled(view.can_undo, egui::Button::new("Undo").shortcut_text("Ctrl+Z")).clicked() {
+                commands.push(Command::Undo);
                 ui.close();
             }
-            if ui.add_enabled(app.can_redo(), egui::Button::new("Redo").shortcut_text("Ctrl+Shift+Z")).clicked() {
-                app.redo();
+            if ui.add_enabled(view.can_redo, egui::Button::new("Redo").shortcut_text("Ctrl+Shift+Z")).clicked() {
+                commands.push(Command::Redo);
                 ui.close();
             }
         });
         ui.menu_button("View", |ui| {
             for count in [1, 2, 4] {
-                if ui
-                    .radio(app.pane_count() == count, format!("{count} pane{}", if count == 1 { "" } else { "s" }))
-                    .clicked()
-                {
-                    app.set_pane_count(count);
+                let label = format!("{count} pane{}", if count == 1 { "" } else { "s" });
+                if ui.radio(view.panes == count, label).clicked() {
+                    commands.push(Command::SetPanes(count));
                     ui.close();
                 }
             }
             ui.separator();
-            ui.checkbox(&mut app.show_plots, "Plots");
-            ui.checkbox(&mut app.show_difference, "Difference view");
-            ui.checkbox(&mut app.show_debug, "Debug overlay (frame time)");
+            for (panel, shown, label) in [
+                (Panel::Plots, view.plots, "Plots"),
+                (Panel::Difference, view.difference, "Difference view"),
+                (Panel::Debug, view.debug, "Debug overlay (frame time)"),
+            ] {
+                let mut on = shown;
+                if ui.checkbox(&mut on, label).changed() {
+                    commands.push(Command::Show(panel, on));
+                }
+            }
         });
         ui.menu_button("Help", |ui| {
             ui.label("Drag: orbit · Shift+drag: pan · Scroll: dolly · Click: select");
@@ -96,10 +62,60 @@ pub fn menu_bar_ui(ui: &mut egui::Ui, app: &mut StudioApp) {
             ui.separator();
             ui.label(format!("GI Studio {} — Whitted, path tracing, photon mapping, SPPM", env!("CARGO_PKG_VERSION")));
         });
-        if let Some(path) = &app.scene_path {
+        if let Some((path, dirty)) = view.file {
             ui.separator();
-            let mark = if app.is_dirty() { " •" } else { "" };
-            ui.weak(format!("{}{mark}", path.display()));
+            ui.weak(format!("{}{}", path.display(), if dirty { " •" } else { "" }));
         }
     });
+}
+
+fn file_menu_ui(ui: &mut egui::Ui, view: &MenuView, commands: &mut Vec<Command>) {
+    let mut choose = |ui: &mut egui::Ui, command: Command| {
+        commands.push(command);
+        ui.close();
+    };
+    ui.menu_button("New from preset", |ui| {
+        for name in presets::names() {
+            if ui.button(name).clicked() {
+                choose(ui, Command::Request(Action::NewFromPreset(name.to_owned())));
+            }
+        }
+    });
+    if ui.button("Open…").clicked() {
+        choose(ui, Command::OpenDialog(DialogPurpose::OpenScene));
+    }
+    ui.menu_button("Open recent", |ui| {
+        if view.recent.is_empty() {
+            ui.weak("Nothing yet");
+        }
+        for path in view.recent {
+            if ui.button(path.display().to_string()).clicked() {
+                choose(ui, Command::Request(Action::Open(path.clone())));
+            }
+        }
+    });
+    if ui.add(egui::Button::new("Save").shortcut_text("Ctrl+S")).clicked() {
+        choose(ui, Command::Save);
+    }
+    if ui.button("Save as…").clicked() {
+        choose(ui, Command::OpenDialog(DialogPurpose::SaveScene));
+    }
+    ui.menu_button("Export image", |ui| {
+        if ui.button("PNG (display)…").clicked() {
+            choose(ui, Command::OpenDialog(DialogPurpose::ExportPng));
+        }
+        if ui.button("EXR (linear)…").clicked() {
+            choose(ui, Command::OpenDialog(DialogPurpose::ExportExr));
+        }
+    });
+    if ui.button("Save window screenshot…").clicked() {
+        choose(ui, Command::OpenDialog(DialogPurpose::Screenshot));
+    }
+    if ui.button("Export comparison sheet…").clicked() {
+        choose(ui, Command::OpenDialog(DialogPurpose::ComparisonSheet));
+    }
+    ui.separator();
+    if ui.button("Quit").clicked() {
+        choose(ui, Command::Request(Action::Quit));
+    }
 }

@@ -1,22 +1,31 @@
 //! The studio window (eframe/egui). It depends on every layer below; none
-//! depends on it. It reaches the engine only through `RenderSession`s.
+//! depends on it. It reaches the engine only through `RenderSession`s. The
+//! rooms: the document (scene, file, history), the panes, the dialogs, the
+//! capture of screenshots, the difference view, the plots; the menus and
+//! dialogs return commands that `studio` applies once per frame.
 
 mod capture;
+mod commands;
+mod dialogs;
+mod difference;
+mod document;
 mod export;
 mod files;
 mod history;
 mod inspector;
 mod menu;
 mod pane;
+mod panes;
 mod plots;
 mod storage;
 mod studio;
 mod viewport;
 
+pub use commands::Action;
 pub use inspector::Selection;
 pub use pane::{Pane, PaneState, PassRecord};
-pub use studio::{Action, Persisted, StudioApp};
-pub use viewport::pick;
+pub use storage::Persisted;
+pub use studio::StudioApp;
 
 use std::path::PathBuf;
 
@@ -81,7 +90,7 @@ pub fn run(args: StudioArgs) -> anyhow::Result<()> {
             if let Some(file) = state {
                 app.keep_state_in(file);
             }
-            exit_error = Some(app.exit_error.clone());
+            exit_error = Some(app.exit_error());
             Ok(Box::new(app))
         }),
     )

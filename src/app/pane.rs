@@ -9,11 +9,12 @@ use std::time::Duration;
 use eframe::egui;
 
 use crate::analysis::metrics::{rel_mse, RelMseOptions};
+use crate::limits;
 use crate::render::image::tonemap_srgb8;
 use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::world::camera::TileRect;
-use crate::render::{Algorithm, LinearImage, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
-use crate::scene::Scene;
+use crate::render::{Algorithm, LinearImage, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
+use crate::scene::ValidScene;
 
 /// One point of a pane's convergence history.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -115,16 +116,16 @@ impl PaneState {
 }
 
 pub struct Pane {
-    pub settings: RenderSettings,
-    pub exposure: f32,
-    pub state: PaneState,
+    settings: RenderSettings,
+    exposure: f32,
+    state: PaneState,
     /// None when the OS refused the worker thread (said in `state.failed`).
     session: Option<RenderSession>,
     texture: Option<egui::TextureHandle>,
 }
 
 impl Pane {
-    pub fn new(ctx: &egui::Context, settings: RenderSettings) -> Self {
+    pub fn new(ctx: &egui::Context, settings: RenderSettings, exposure: f32) -> Self {
         let repaint = ctx.clone();
         let mut state = PaneState::new(0, settings.width, settings.height);
         let session = match RenderSession::new(Some(Arc::new(move || repaint.request_repaint()))) {
@@ -134,7 +135,24 @@ impl Pane {
                 None
             }
         };
-        Self { state, settings, exposure: 0.0, session, texture: None }
+        Self { state, settings, exposure, session, texture: None }
+    }
+
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// The settings, to change; the pane renders with them at its next restart.
+    pub fn settings_mut(&mut self) -> &mut RenderSettings {
+        &mut self.settings
+    }
+
+    pub fn state(&self) -> &PaneState {
+        &self.state
+    }
+
+    pub fn exposure(&self) -> f32 {
+        self.exposure
     }
 
     pub fn algorithm(&self) -> Algorithm {
@@ -142,7 +160,7 @@ impl Pane {
     }
 
     /// Abandon the current job and render `scene` afresh (never waits).
-    pub fn restart(&mut self, scene: Arc<Scene>) {
+    pub fn restart(&mut self, scene: Arc<ValidScene>) {
         let Some(session) = &self.session else { return };
         let generation = session.start(RenderJob::new(scene, self.settings.clone()));
         self.state = PaneState::new(generation, self.settings.width, self.settings.height);
@@ -224,6 +242,75 @@ impl Pane {
 
     pub fn elapsed(&self) -> Duration {
         self.state.stats.map_or(Duration::ZERO, |s| s.elapsed)
+    }
+}
+
+impl Pane {
+    /// The pane's settings, only the knobs of its algorithm; returns
+    /// whether the pane must restart.
+    pub fn settings_ui(&mut self, ui: &mut egui::Ui) -> bool {
+        let before = self.settings.clone();
+        let s = &mut self.settings;
+        // The engine's limits, narrowed where a pane cannot use more
+        let range = |limit: limits::Limit<u32>| limit.min..=limit.max;
+        let mut spp = s.samples_per_pixel.unwrap_or(0);
+        let target = egui::DragValue::new(&mut spp).range(0..=limits::SAMPLES_PER_PIXEL.max);
+        ui.add(target.prefix("spp target (0: none) "));
+        s.samples_per_pixel = (spp > 0).then_some(spp);
+        let mut budget = s.time_limit.unwrap_or(0.0);
+        let time = egui::DragValue::new(&mut budget).range(0.0..=limits::SECONDS.max).speed(0.5);
+        ui.add(time.prefix("time budget s (0: none) "));
+        s.time_limit = (budget > 0.0).then_some(budget);
+        ui.add(egui::DragValue::new(&mut s.max_depth).range(range(limits::MAX_DEPTH)).prefix("max depth "));
+        ui.add(egui::DragValue::new(&mut s.width).range(16..=4096).prefix("width "));
+        ui.add(egui::DragValue::new(&mut s.height).range(16..=4096).prefix("height "));
+        match &mut s.method {
+            Method::Whitted | Method::Path => {}
+            Method::Photon(p) => {
+                ui.separator();
+                let photons = range(limits::PHOTONS);
+                let global = egui::DragValue::new(&mut p.global_photons).range(photons.clone()).speed(1000);
+                ui.add(global.prefix("global photons "));
+                let caustic = egui::DragValue::new(&mut p.caustic_photons).range(photons).speed(1000);
+                ui.add(caustic.prefix("caustic photons "));
+                ui.add(egui::DragValue::new(&mut p.k_nearest).range(8..=1000).prefix("k nearest "));
+                let radius = egui::DragValue::new(&mut p.max_radius).range(0.0..=1e6).speed(0.001);
+                ui.add(radius.prefix("max radius (0: auto) "));
+                ui.checkbox(&mut p.final_gather, "final gather");
+                ui.add(egui::DragValue::new(&mut p.final_gather_rays).range(1..=1024).prefix("gather rays "));
+            }
+            Method::Sppm(p) => {
+                ui.separator();
+                let photons = egui::DragValue::new(&mut p.photons_per_pass).range(range(limits::SPPM_PHOTONS));
+                ui.add(photons.speed(1000).prefix("photons per pass "));
+                let radius = egui::DragValue::new(&mut p.initial_radius).range(0.0..=1e6).speed(0.001);
+                ui.add(radius.prefix("initial radius (0: auto) "));
+                ui.add(egui::Slider::new(&mut p.alpha, 0.05..=1.0).text("α"));
+            }
+        }
+        ui.separator();
+        if ui.add(egui::Slider::new(&mut self.exposure, -8.0..=8.0).text("exposure (stops)")).changed() {
+            self.refresh_texture();
+        }
+        self.settings != before
+    }
+
+    /// The algorithm chooser; returns whether the algorithm changed.
+    pub fn algorithm_ui(&mut self, ui: &mut egui::Ui, index: usize) -> bool {
+        let mut algorithm = self.settings.algorithm();
+        egui::ComboBox::new(("algorithm", index), format!("pane {}", index + 1))
+            .selected_text(algorithm.label())
+            .show_ui(ui, |ui| {
+                for a in Algorithm::ALL {
+                    ui.selectable_value(&mut algorithm, a, a.label());
+                }
+            });
+        if algorithm == self.settings.algorithm() {
+            return false;
+        }
+        self.settings.method = Method::of(algorithm);
+        self.settings.max_depth = algorithm.default_max_depth();
+        true
     }
 }
 

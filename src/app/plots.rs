@@ -15,7 +15,7 @@ pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
         Plot::new("pass_time").legend(Legend::default()).height(height).show(&mut columns[0], |plot| {
             for (i, pane) in panes.iter().enumerate() {
                 let points: Vec<[f64; 2]> =
-                    pane.state.history.iter().map(|r| [r.passes as f64, r.pass_seconds * 1e3]).collect();
+                    pane.state().history.iter().map(|r| [r.passes as f64, r.pass_seconds * 1e3]).collect();
                 plot.line(Line::new(series_name(i, pane), points));
             }
         });
@@ -23,7 +23,7 @@ pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
         Plot::new("throughput").legend(Legend::default()).height(height).show(&mut columns[1], |plot| {
             for (i, pane) in panes.iter().enumerate() {
                 let points: Vec<[f64; 2]> =
-                    pane.state.history.iter().map(|r| [r.seconds, r.samples_per_second / 1e6]).collect();
+                    pane.state().history.iter().map(|r| [r.seconds, r.samples_per_second / 1e6]).collect();
                 plot.line(Line::new(series_name(i, pane), points));
             }
         });
@@ -31,7 +31,7 @@ pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
         Plot::new("error").legend(Legend::default()).height(height).show(&mut columns[2], |plot| {
             for (i, pane) in panes.iter().enumerate() {
                 let points: Vec<[f64; 2]> = pane
-                    .state
+                    .state()
                     .history
                     .iter()
                     .filter_map(|r| r.error.filter(|e| *e > 0.0).map(|e| [r.seconds.max(1e-6).log10(), e.log10()]))
@@ -51,7 +51,7 @@ fn photon_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
     ui.label("Photon maps");
     let mut any = false;
     for (i, pane) in panes.iter().enumerate() {
-        if let Some(maps) = &pane.state.maps {
+        if let Some(maps) = &pane.state().maps {
             any = true;
             for (name, map) in [("global", &maps.global), ("caustic", &maps.caustic)] {
                 ui.small(format!(
@@ -65,7 +65,7 @@ fn photon_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
                 ));
             }
         }
-        if let Some(stats) = &pane.state.stats {
+        if let Some(stats) = &pane.state().stats {
             let q = &stats.photon.queries;
             if q.queries > 0 {
                 any = true;
@@ -100,7 +100,7 @@ fn photon_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
         .map(|(i, pane)| {
             (
                 i,
-                pane.state
+                pane.state()
                     .history
                     .iter()
                     .filter_map(|r| r.sppm_radius.map(|radius| [r.passes as f64, radius as f64]))

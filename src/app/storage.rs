@@ -7,8 +7,69 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use serde::{Deserialize, Serialize};
+
 use crate::fileio::{self, FileError};
 use crate::limits;
+use crate::render::RenderSettings;
+
+/// What survives a restart: the layout, each pane's settings, the files.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Persisted {
+    pub panes: Vec<RenderSettings>,
+    pub exposures: Vec<f32>,
+    pub show_plots: bool,
+    pub recent: Vec<PathBuf>,
+}
+
+impl Default for Persisted {
+    fn default() -> Self {
+        Self { panes: Vec::new(), exposures: Vec::new(), show_plots: true, recent: Vec::new() }
+    }
+}
+
+/// Saved state made safe to start from: a pane whose saved settings break
+/// a limit gets its defaults (`None`), and every fallback is said.
+pub struct Restored {
+    pub panes: Vec<Option<RenderSettings>>,
+    pub exposures: Vec<f32>,
+    pub show_plots: bool,
+    pub recent: Vec<PathBuf>,
+    pub notices: Vec<String>,
+}
+
+impl Persisted {
+    /// The saved state checked as a scene file is: whatever it holds, the
+    /// studio starts, and values out of their limits fall back to defaults.
+    pub fn restore(self) -> Restored {
+        let mut notices = Vec::new();
+        if self.panes.len() > 4 {
+            notices.push(format!("{} saved panes; the studio shows at most 4", self.panes.len()));
+        }
+        let panes = (self.panes.into_iter().take(4).enumerate())
+            .map(|(i, settings)| match settings.problems().first() {
+                None => Some(settings),
+                Some(problem) => {
+                    notices.push(format!("pane {}'s saved {problem}; its defaults are used", i + 1));
+                    None
+                }
+            })
+            .collect();
+        let exposures = (self.exposures.into_iter().take(4).enumerate())
+            .map(|(i, exposure)| {
+                limits::EXPOSURE_STOPS.check(exposure).unwrap_or_else(|problem| {
+                    notices.push(format!("pane {}'s saved exposure {problem}; 0 is used", i + 1));
+                    0.0
+                })
+            })
+            .collect();
+        let recent = self.recent.into_iter().take(RECENT_FILES).collect();
+        Restored { panes, exposures, show_plots: self.show_plots, recent, notices }
+    }
+}
+
+const RECENT_FILES: usize = 8;
 
 pub struct StateFile {
     path: PathBuf,

@@ -5,21 +5,10 @@
 use eframe::egui;
 use glam::{Quat, Vec3};
 
+use super::document::Document;
 use super::inspector::Selection;
 use super::pane::Pane;
-use crate::render::world::camera::CameraModel;
-use crate::render::world::World;
-use crate::scene::{Camera, Scene};
-
-/// Index of the object seen through film position (x, y) of a `width ×
-/// height` image, by the engine's own geometry.
-pub fn pick(scene: &Scene, width: u32, height: u32, x: f32, y: f32) -> Option<usize> {
-    if !scene.validate().is_empty() {
-        return None;
-    }
-    let ray = CameraModel::new(&scene.camera, width, height).pixel_ray(x, y);
-    World::new(scene).intersect(&ray, f32::INFINITY).map(|hit| hit.object as usize)
-}
+use crate::scene::Camera;
 
 /// Turn the camera about its look-at point: `yaw` about the up vector,
 /// `pitch` about the camera's right vector (stopping short of the poles).
@@ -57,10 +46,16 @@ pub fn dolly(camera: &mut Camera, factor: f32) {
     }
 }
 
-/// Draw the pane and apply its interactions to `scene` and `selection`.
-pub fn viewport_ui(ui: &mut egui::Ui, pane: &mut Pane, scene: &mut Scene, selection: &mut Selection) -> egui::Response {
+/// Draw the pane and apply its interactions to the document's camera (a
+/// change of it is an edit) and the selection.
+pub fn viewport_ui(
+    ui: &mut egui::Ui,
+    pane: &mut Pane,
+    document: &mut Document,
+    selection: &mut Selection,
+) -> egui::Response {
     let texture = pane.texture(ui.ctx()).clone();
-    let (width, height) = (pane.state.image.width as f32, pane.state.image.height as f32);
+    let (width, height) = (pane.state().image.width as f32, pane.state().image.height as f32);
     let available = ui.available_size();
     let scale = (available.x / width).min(available.y / height).max(0.01);
     let (rect, response) =
@@ -73,7 +68,7 @@ pub fn viewport_ui(ui: &mut egui::Ui, pane: &mut Pane, scene: &mut Scene, select
     let label_rect = egui::Rect::from_min_size(rect.min, galley.size() + egui::vec2(12.0, 6.0));
     ui.painter().rect_filled(label_rect, 3.0, egui::Color32::from_black_alpha(160));
     ui.painter().galley(rect.min + egui::vec2(6.0, 3.0), galley, egui::Color32::WHITE);
-    if let Some(message) = &pane.state.failed {
+    if let Some(message) = &pane.state().failed {
         ui.painter().text(
             rect.center(),
             egui::Align2::CENTER_CENTER,
@@ -87,24 +82,27 @@ pub fn viewport_ui(ui: &mut egui::Ui, pane: &mut Pane, scene: &mut Scene, select
     if response.clicked() {
         if let Some(pos) = response.interact_pointer_pos() {
             let (x, y) = to_film(pos);
-            match pick(scene, width as u32, height as u32, x, y) {
+            match document.pick(width as u32, height as u32, x, y) {
                 Some(object) => *selection = Selection::Object(object),
                 None => *selection = Selection::Camera,
             }
         }
     }
-    if response.dragged() {
-        let delta = response.drag_delta();
+    let delta = response.drag_delta();
+    if response.dragged() && delta != egui::Vec2::ZERO {
+        let camera = &mut document.scene_mut().camera;
         if ui.input(|i| i.modifiers.shift) {
-            pan(&mut scene.camera, delta.x / rect.height(), delta.y / rect.height());
+            pan(camera, delta.x / rect.height(), delta.y / rect.height());
         } else {
-            orbit(&mut scene.camera, -delta.x * 0.01, -delta.y * 0.01);
+            orbit(camera, -delta.x * 0.01, -delta.y * 0.01);
         }
+        document.changed();
     }
     if response.hovered() {
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
         if scroll != 0.0 {
-            dolly(&mut scene.camera, (-scroll * 0.002).exp());
+            dolly(&mut document.scene_mut().camera, (-scroll * 0.002).exp());
+            document.changed();
         }
     }
     response
@@ -129,11 +127,16 @@ mod tests {
     }
 
     #[test]
-    fn picking_finds_the_glass_ball_in_the_cornell_box() {
+    fn picking_finds_the_glass_ball_in_the_cornell_box_and_nothing_in_a_broken_scene() {
         let scene = default_scene();
-        let camera = CameraModel::new(&scene.camera, 160, 120);
+        let camera = crate::render::world::camera::CameraModel::new(&scene.camera, 160, 120);
         let ball = scene.objects.iter().position(|o| o.name == "glass ball").unwrap();
         let p = camera.project(glam::Vec3::new(0.45, 0.35, 0.2)).unwrap();
-        assert_eq!(pick(&scene, 160, 120, p.x, p.y), Some(ball));
+        let mut document = Document::new(scene, None, true);
+        assert_eq!(document.pick(160, 120, p.x, p.y), Some(ball));
+        document.scene_mut().objects[ball].material = "nowhere".into();
+        document.changed();
+        document.check();
+        assert_eq!(document.pick(160, 120, p.x, p.y), None);
     }
 }

@@ -20,7 +20,7 @@ use crate::analysis::plot::plot_error_against_time;
 use crate::fileio::{self, SIGNATURE};
 use crate::limits;
 use crate::render::{Algorithm, LinearImage, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
-use crate::scene::{load_scene, Scene};
+use crate::scene::{load_scene, ValidScene};
 
 #[derive(Debug, Args)]
 pub struct BenchArgs {
@@ -61,7 +61,7 @@ pub struct Run {
 /// Render `scene` with `settings` until its budget, logging error against
 /// `reference` after every pass (FLIP at roughly log-spaced times).
 pub fn measure(
-    scene: &Scene,
+    scene: &Arc<ValidScene>,
     settings: RenderSettings,
     reference: &LinearImage,
     progress: Option<&ProgressBar>,
@@ -69,7 +69,7 @@ pub fn measure(
     let session = RenderSession::new(None).context("could not start the render worker")?;
     let (width, height) = (settings.width, settings.height);
     let algorithm = settings.algorithm();
-    let generation = session.start(RenderJob::new(Arc::new(scene.clone()), settings));
+    let generation = session.start(RenderJob::new(scene.clone(), settings));
     let mut image = LinearImage::new(width, height);
     let mut log = ConvergenceLog::default();
     let mut next_flip = 0.0;
@@ -142,7 +142,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let sign: &[&[u8]] = &[SIGNATURE.as_bytes()];
     for scene_path in &scenes {
         let name = stem(scene_path);
-        let scene = load_scene(scene_path)?;
+        let scene = Arc::new(load_scene(scene_path)?);
         let reference_path = args.references.join(format!("{name}.exr"));
         let reference = LinearImage::load(&reference_path).with_context(|| format!("the reference for {name}"))?;
         outputs.input(scene_path);

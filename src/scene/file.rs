@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Invalid, Scene};
+use super::{Invalid, Scene, ValidScene};
 use crate::fileio::{self, FileError};
 use crate::limits;
 
@@ -31,23 +31,23 @@ fn more_note(others: usize) -> String {
 
 /// Read and validate a scene file: a regular file of at most
 /// `limits::TEXT_FILE_BYTES`, UTF-8.
-pub fn load_scene(path: &Path) -> Result<Scene, SceneFileError> {
+pub fn load_scene(path: &Path) -> Result<ValidScene, SceneFileError> {
     let text = fileio::read_text(path, limits::TEXT_FILE_BYTES)?;
     parse_scene(&text, path)
 }
 
 /// Parse and validate scene text; `path` is only used in messages.
-pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneFileError> {
+pub fn parse_scene(text: &str, path: &Path) -> Result<ValidScene, SceneFileError> {
     let scene: Scene = ron::Options::default().from_str(text).map_err(|e| SceneFileError::Syntax {
         path: path.to_owned(),
         line: e.span.start.line,
         column: e.span.start.col,
         message: e.code.to_string(),
     })?;
-    let mut problems = scene.validate();
-    if problems.is_empty() {
-        return Ok(scene);
-    }
+    let mut problems = match ValidScene::new(scene) {
+        Ok(valid) => return Ok(valid),
+        Err(problems) => problems,
+    };
     let others = problems.len() - 1;
     let invalid = problems.swap_remove(0);
     let (line, column) = locate(text, &invalid);

@@ -4,9 +4,11 @@
 
 mod file;
 pub mod presets;
+mod valid;
 mod validate;
 
 pub use file::{load_scene, parse_scene, save_scene, to_ron, SceneFileError};
+pub use valid::ValidScene;
 pub use validate::{Invalid, Problem};
 
 use glam::Vec3;

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{parse_scene, Scene, SceneFileError};
+use super::{parse_scene, Scene, SceneFileError, ValidScene};
 
 /// (name, RON text) of every preset, in menu order.
 pub const PRESETS: &[(&str, &str)] = &[
@@ -19,7 +19,7 @@ pub fn names() -> impl Iterator<Item = &'static str> {
 }
 
 /// The preset called `name`, parsed and validated.
-pub fn preset(name: &str) -> Option<Result<Scene, SceneFileError>> {
+pub fn preset(name: &str) -> Option<Result<ValidScene, SceneFileError>> {
     let (name, text) = PRESETS.iter().find(|(n, _)| *n == name)?;
     Some(parse_scene(text, Path::new(&format!("assets/scenes/{name}.ron"))))
 }
@@ -27,7 +27,7 @@ pub fn preset(name: &str) -> Option<Result<Scene, SceneFileError>> {
 /// The scene the studio opens on.
 pub fn default_scene() -> Scene {
     match preset("cornell") {
-        Some(Ok(scene)) => scene,
+        Some(Ok(scene)) => scene.into_scene(),
         // Unreachable while the preset test passes; keep the studio usable anyway.
         _ => fallback_scene(),
     }

@@ -54,6 +54,11 @@ pub fn floor_scene(albedo: f32, lights: Vec<Light>) -> Scene {
     )
 }
 
+/// `scene`, checked: what the renderer takes.
+pub fn valid(scene: impl Into<Scene>) -> ValidScene {
+    ValidScene::new(scene.into()).expect("a valid scene")
+}
+
 pub fn mean_luminance(pixels: &[[f32; 3]]) -> f64 {
     pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / pixels.len() as f64
 }

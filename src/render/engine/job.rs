@@ -17,12 +17,12 @@ use crate::render::integrators::{Integrator, PassObserver, Stage};
 use crate::render::settings::RenderSettings;
 use crate::render::world::camera::{CameraModel, TileRect};
 use crate::render::world::World;
-use crate::scene::Scene;
+use crate::scene::ValidScene;
 
 /// A scene snapshot and how to render it.
 #[derive(Clone, Debug)]
 pub struct RenderJob {
-    pub scene: Arc<Scene>,
+    pub scene: Arc<ValidScene>,
     pub settings: RenderSettings,
     /// Photon maps made earlier for this scene and these settings (loaded
     /// from a file); traced afresh when absent.
@@ -33,7 +33,7 @@ pub struct RenderJob {
 }
 
 impl RenderJob {
-    pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Self {
+    pub fn new(scene: Arc<ValidScene>, settings: RenderSettings) -> Self {
         Self { scene, settings, photon_maps: None, stream_tiles: true }
     }
 }
@@ -76,10 +76,6 @@ impl PassObserver for JobContext<'_> {
 pub(super) fn run_job(context: &JobContext, job: &RenderJob) {
     let settings = &job.settings;
     let generation = context.generation;
-    if let Some(problem) = job.scene.validate().into_iter().next() {
-        context.send(RenderEvent::Failed { generation, message: problem.to_string() });
-        return;
-    }
     if let Some(problem) = settings.problems().into_iter().next() {
         context.send(RenderEvent::Failed { generation, message: problem.to_string() });
         return;

@@ -16,7 +16,7 @@ use glam::Vec3;
 
 use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
 use crate::geometry::{plane_hit, plane_t, sphere_hit};
-use crate::scene::{LightKind, MaterialModel, Rgb, Scene, Shape};
+use crate::scene::{LightKind, MaterialModel, Rgb, Shape, ValidScene};
 use camera::CameraModel;
 use light::{Emitter, EmitterCap, LightSource};
 use occluders::{Occluders, Walls};
@@ -52,8 +52,8 @@ pub struct World {
 }
 
 impl World {
-    /// Compile a validated scene.
-    pub fn new(scene: &Scene) -> Self {
+    /// Compile a scene for rendering.
+    pub fn new(scene: &ValidScene) -> Self {
         let mut world = World {
             spheres: Spheres::default(),
             planes: Vec::new(),
@@ -229,7 +229,7 @@ impl World {
     /// The world as a render through `camera` at width × height uses it
     /// (`cover`ed by what the camera sees), and the size of what it sees
     /// (`visible_radius`, or the bounds' where it sees nothing).
-    pub fn for_view(scene: &Scene, camera: &CameraModel, width: u32, height: u32) -> (World, f32) {
+    pub fn for_view(scene: &ValidScene, camera: &CameraModel, width: u32, height: u32) -> (World, f32) {
         let mut world = World::new(scene);
         let visible = world.visible_points(camera, width, height);
         world.cover(&visible, camera);

@@ -277,11 +277,12 @@ mod tests {
     use crate::scene::{Light, LightKind, Scene};
 
     fn preset(name: &str) -> Scene {
-        crate::scene::presets::preset(name).and_then(Result::ok).expect("preset")
+        crate::scene::presets::preset(name).and_then(Result::ok).expect("preset").into_scene()
     }
 
     fn world(scene: &Scene) -> World {
-        World::for_view(scene, &CameraModel::new(&scene.camera, 64, 48), 64, 48).0
+        let valid = crate::scene::ValidScene::new(scene.clone()).expect("valid");
+        World::for_view(&valid, &CameraModel::new(&scene.camera, 64, 48), 64, 48).0
     }
 
     fn point_light(position: Vec3) -> Light {
@@ -312,7 +313,8 @@ mod tests {
         scene.lights.push(point_light(Vec3::new(50.0, 200.0, 80.0)));
         let w = world(&scene);
         assert_eq!((w.walls.regions.len(), w.walls.spheres.len()), (5, 4));
-        scene.lights.push(Light { kind: LightKind::Directional { direction: -Vec3::Y }, ..point_light(Vec3::ZERO) });
+        let sun = LightKind::Directional { direction: -Vec3::Y };
+        scene.lights.push(Light { name: "sun".into(), kind: sun, ..point_light(Vec3::ZERO) });
         assert!(world(&scene).walls.regions.is_empty());
         let mut scene = preset("cornell");
         scene.lights.push(point_light(Vec3::new(0.0, 1.0, -3.0)));

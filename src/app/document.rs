@@ -1,0 +1,174 @@
+//! The document: the scene being edited, its file, its history and its
+//! revision. Every edit bumps the revision (the widgets say when they
+//! changed something), so nothing compares scenes frame by frame; the scene
+//! is checked once per revision, and each valid revision becomes one
+//! `ValidScene` snapshot for the panes and one `World` for picking.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::history::History;
+use crate::render::world::camera::CameraModel;
+use crate::render::world::World;
+use crate::scene::{save_scene, to_ron, Invalid, Scene, SceneFileError, ValidScene};
+
+pub struct Document {
+    scene: Scene,
+    path: Option<PathBuf>,
+    revision: u64,
+    /// Revisions are never reused: an undo returns to an old number.
+    next_revision: u64,
+    /// The revision the file holds (None: nothing saved matches).
+    saved: Option<u64>,
+    history: History,
+    /// The revision last checked, what was wrong with it, and the newest
+    /// valid snapshot with its world.
+    checked: u64,
+    problems: Vec<Invalid>,
+    valid: Option<(Arc<ValidScene>, Arc<World>)>,
+}
+
+impl Document {
+    /// A document holding `scene`, saved (`path`) or not; `clean` when it
+    /// is what its source holds (a file, a preset).
+    pub fn new(scene: Scene, path: Option<PathBuf>, clean: bool) -> Self {
+        let history = History::new(&scene, 1);
+        let mut document = Self {
+            scene,
+            path,
+            revision: 1,
+            next_revision: 2,
+            saved: clean.then_some(1),
+            history,
+            checked: 0,
+            problems: Vec::new(),
+            valid: None,
+        };
+        document.check();
+        document
+    }
+
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The scene to edit in place; say `changed` when something was.
+    pub fn scene_mut(&mut self) -> &mut Scene {
+        &mut self.scene
+    }
+
+    /// The scene was edited: a new revision.
+    pub fn changed(&mut self) {
+        self.revision = self.next_revision;
+        self.next_revision += 1;
+    }
+
+    pub fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
+    }
+
+    pub fn is_dirty(&self) -> bool {
+        self.saved != Some(self.revision)
+    }
+
+    /// Commit the edits as one undo step once the user lets go.
+    pub fn commit(&mut self, interacting: bool) {
+        self.history.observe(&self.scene, self.revision, interacting);
+    }
+
+    pub fn can_undo(&self) -> bool {
+        self.history.can_undo()
+    }
+
+    pub fn can_redo(&self) -> bool {
+        self.history.can_redo()
+    }
+
+    pub fn undo(&mut self) {
+        self.history.undo(&mut self.scene, &mut self.revision);
+    }
+
+    pub fn redo(&mut self) {
+        self.history.redo(&mut self.scene, &mut self.revision);
+    }
+
+    /// Check the scene if its revision is new. Returns the new valid
+    /// snapshot when there is one (the panes restart with it).
+    pub fn check(&mut self) -> Option<Arc<ValidScene>> {
+        if self.checked == self.revision {
+            return None;
+        }
+        self.checked = self.revision;
+        match ValidScene::new(self.scene.clone()) {
+            Ok(valid) => {
+                self.problems.clear();
+                let world = Arc::new(World::new(&valid));
+                let valid = Arc::new(valid);
+                self.valid = Some((valid.clone(), world));
+                Some(valid)
+            }
+            Err(problems) => {
+                self.problems = problems;
+                None
+            }
+        }
+    }
+
+    /// What is wrong with the scene (empty when it renders).
+    pub fn problems(&self) -> &[Invalid] {
+        &self.problems
+    }
+
+    /// The newest valid snapshot, if the scene as it stands is valid.
+    pub fn valid(&self) -> Option<&Arc<ValidScene>> {
+        self.valid.as_ref().filter(|_| self.problems.is_empty()).map(|(scene, _)| scene)
+    }
+
+    /// The object seen through film position (x, y) of a `width × height`
+    /// image, through the world of the scene's last valid revision.
+    pub fn pick(&self, width: u32, height: u32, x: f32, y: f32) -> Option<usize> {
+        let (scene, world) = self.valid.as_ref().filter(|_| self.problems.is_empty())?;
+        let ray = CameraModel::new(&scene.camera, width, height).pixel_ray(x, y);
+        world.intersect(&ray, f32::INFINITY).map(|hit| hit.object as usize)
+    }
+
+    /// Write the scene to `path`; it is the document's file from then on.
+    pub fn save_to(&mut self, path: &Path) -> Result<(), SceneFileError> {
+        save_scene(&self.scene, path)?;
+        self.path = Some(path.to_owned());
+        self.saved = Some(self.revision);
+        Ok(())
+    }
+
+    /// The scene as an autosave holds it, while it has unsaved edits.
+    pub fn autosave_text(&self) -> Option<Result<String, SceneFileError>> {
+        self.is_dirty().then(|| to_ron(&self.scene))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::presets::default_scene;
+
+    #[test]
+    fn revisions_track_edits_undo_returns_to_clean_and_checks_happen_once() {
+        let mut document = Document::new(default_scene(), None, true);
+        assert!(!document.is_dirty() && document.valid().is_some());
+        assert!(document.check().is_none(), "nothing new to check");
+        document.scene_mut().camera.fov_y_degrees = 50.0;
+        document.changed();
+        document.commit(false);
+        assert!(document.is_dirty());
+        let snapshot = document.check().expect("a new valid revision");
+        assert_eq!(snapshot.camera.fov_y_degrees, 50.0);
+        document.scene_mut().objects[5].material = "nowhere".into();
+        document.changed();
+        assert!(document.check().is_none() && document.valid().is_none() && !document.problems().is_empty());
+        document.undo();
+        assert!(document.is_dirty());
+        document.undo();
+        assert!(!document.is_dirty(), "back at the saved revision");
+        assert!(document.check().is_some());
+    }
+}
