@@ -16,7 +16,7 @@ fn studio(panes: usize) -> Harness<'static, StudioApp> {
     let args = StudioArgs { panes: Some(panes), ..Default::default() };
     let mut app = StudioApp::new(&egui::Context::default(), None, &args);
     // Small images keep the tests quick
-    for pane in app.panes_mut() {
+    for pane in app.panes_mut().list_mut() {
         pane.settings_mut().width = 64;
         pane.settings_mut().height = 48;
         pane.settings_mut().samples_per_pixel = Some(2);
@@ -48,9 +48,9 @@ fn radius_of(app: &StudioApp, name: &str) -> f32 {
 #[test]
 fn editing_a_radius_in_the_inspector_restarts_and_undo_redo_restore_both_states() {
     let mut harness = studio(1);
-    step_until(&mut harness, |app| app.panes()[0].state().passes() >= 1);
+    step_until(&mut harness, |app| app.panes().list()[0].state().passes() >= 1);
     let original = harness.state().scene().clone();
-    let generation = harness.state().generations()[0];
+    let generation = harness.state().panes().generations()[0];
     harness.get_by_label("mirror ball (sphere)").click();
     harness.run_steps(2);
     assert_eq!(harness.state().selection(), Selection::Object(5));
@@ -62,7 +62,7 @@ fn editing_a_radius_in_the_inspector_restarts_and_undo_redo_restore_both_states(
     harness.key_press(egui::Key::Enter);
     harness.run_steps(3);
     assert_eq!(radius_of(harness.state(), "mirror ball"), 0.2);
-    assert!(harness.state().generations()[0] > generation, "the edit must restart the render");
+    assert!(harness.state().panes().generations()[0] > generation, "the edit must restart the render");
     let edited = harness.state().scene().clone();
 
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
@@ -77,16 +77,16 @@ fn editing_a_radius_in_the_inspector_restarts_and_undo_redo_restore_both_states(
 fn toggling_a_light_changes_the_scene_and_restarts() {
     let mut harness = studio(1);
     harness.state_mut().open_path(&PathBuf::from("assets/scenes/thesis.ron"));
-    harness.state_mut().panes_mut()[0].settings_mut().width = 64;
-    harness.state_mut().panes_mut()[0].settings_mut().height = 48;
+    harness.state_mut().panes_mut().list_mut()[0].settings_mut().width = 64;
+    harness.state_mut().panes_mut().list_mut()[0].settings_mut().height = 48;
     harness.state_mut().restart_all();
     harness.run_steps(2);
-    let generation = harness.state().generations()[0];
+    let generation = harness.state().panes().generations()[0];
     assert!(harness.state().scene().lights[0].enabled);
     harness.get_all_by_role(Role::CheckBox).next().expect("a light checkbox").click();
     harness.run_steps(2);
     assert!(!harness.state().scene().lights[0].enabled);
-    assert!(harness.state().generations()[0] > generation);
+    assert!(harness.state().panes().generations()[0] > generation);
 }
 
 #[test]
@@ -101,7 +101,7 @@ fn a_broken_file_shows_its_error_and_leaves_the_scene_unchanged() {
     harness.state_mut().open_path(&path);
     harness.run_steps(2);
     assert_eq!(*harness.state().scene(), before);
-    let error = harness.state().error().map(str::to_owned).expect("an error is shown");
+    let error = harness.state().messages().error.clone().expect("an error is shown");
     assert!(error.contains("broken.ron:") && error.contains("ior"), "{error}");
     harness.get_by_label_contains("broken.ron:");
 }
@@ -115,8 +115,8 @@ fn four_panes_show_four_algorithms() {
     harness.get_by_label("4 panes").click();
     harness.run_steps(3);
     let app = harness.state();
-    assert_eq!(app.panes().len(), 4);
-    let mut algorithms: Vec<_> = app.panes().iter().map(|p| p.algorithm()).collect();
+    assert_eq!(app.panes().count(), 4);
+    let mut algorithms: Vec<_> = app.panes().list().iter().map(|p| p.algorithm()).collect();
     algorithms.dedup();
     assert_eq!(algorithms.len(), 4);
     assert_eq!(algorithms, gi_studio::render::Algorithm::ALL.to_vec());
@@ -128,7 +128,7 @@ fn four_panes_show_four_algorithms() {
 #[test]
 fn exporting_a_pane_writes_a_png_of_the_panes_size() {
     let mut harness = studio(1);
-    step_until(&mut harness, |app| app.panes()[0].state().passes() >= 1);
+    step_until(&mut harness, |app| app.panes().list()[0].state().passes() >= 1);
     let path = std::env::temp_dir().join(format!("gi-ui-export-{}.png", std::process::id()));
     harness.state_mut().export_pane(0, &path);
     let decoded = image::open(&path).expect("a PNG");
@@ -138,9 +138,9 @@ fn exporting_a_pane_writes_a_png_of_the_panes_size() {
 #[test]
 fn clicking_a_sphere_in_the_viewport_selects_it() {
     let mut harness = studio(1);
-    step_until(&mut harness, |app| app.panes()[0].state().passes() >= 1);
+    step_until(&mut harness, |app| app.panes().list()[0].state().passes() >= 1);
     let app = harness.state();
-    let rect = app.viewport_rects()[0];
+    let rect = app.panes().rects()[0];
     let camera = CameraModel::new(&app.scene().camera, 64, 48);
     let film = camera.project(glam::Vec3::new(0.45, 0.35, 0.2)).expect("in view");
     let target = rect.min + egui::vec2(film.x / 64.0 * rect.width(), film.y / 48.0 * rect.height());
@@ -182,17 +182,17 @@ fn every_menu_opens_and_draws() {
 #[test]
 fn rendering_pauses_while_minimised_and_resumes_after() {
     let mut harness = studio(1);
-    step_until(&mut harness, |app| app.panes()[0].state().passes() >= 1);
+    step_until(&mut harness, |app| app.panes().list()[0].state().passes() >= 1);
     let minimise = |harness: &mut Harness<'static, StudioApp>, minimised: bool| {
         harness.input_mut().viewports.entry(egui::ViewportId::ROOT).or_default().minimized = Some(minimised);
         harness.run_steps(2);
     };
     minimise(&mut harness, true);
     assert!(harness.state().is_paused());
-    let generation = harness.state().generations()[0];
+    let generation = harness.state().panes().generations()[0];
     minimise(&mut harness, false);
     assert!(!harness.state().is_paused());
-    assert!(harness.state().generations()[0] > generation, "restored: the panes render again");
+    assert!(harness.state().panes().generations()[0] > generation, "restored: the panes render again");
 }
 
 /// eframe storage in memory, as a second start would read it.
@@ -224,7 +224,7 @@ fn layout_is_restored_and_an_unsaved_scene_is_offered_back() {
     };
     // Next start: two panes again, and the edit offered back
     let app = StudioApp::new(&egui::Context::default(), Some(&storage), &StudioArgs::default());
-    assert_eq!(app.panes().len(), 2);
+    assert_eq!(app.panes().count(), 2);
     assert!(app.offers_autosave());
     let mut harness =
         Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app);
@@ -312,14 +312,18 @@ fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
     };
     storage.set_string("studio", ron::to_string(&saved).unwrap());
     let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &StudioArgs::default());
-    assert_eq!(app.panes().len(), 2);
-    let first = app.panes()[0].settings();
+    assert_eq!(app.panes().count(), 2);
+    let first = app.panes().list()[0].settings();
     assert!(first.problems().is_empty(), "{:?}", first.problems());
     assert!(first.width <= 4096 && first.threads == 0 && first.tile_size == 32);
-    assert_eq!(*app.panes()[1].settings(), fine);
-    assert_eq!((app.panes()[0].exposure(), app.panes()[1].exposure()), (0.0, 1.0));
-    assert!(app.status().contains("pane 1's saved size") && app.status().contains("exposure"), "{}", app.status());
-    for pane in app.panes_mut() {
+    assert_eq!(*app.panes().list()[1].settings(), fine);
+    assert_eq!((app.panes().list()[0].exposure(), app.panes().list()[1].exposure()), (0.0, 1.0));
+    assert!(
+        app.messages().status.contains("pane 1's saved size") && app.messages().status.contains("exposure"),
+        "{}",
+        app.messages().status
+    );
+    for pane in app.panes_mut().list_mut() {
         pane.settings_mut().width = 32;
         pane.settings_mut().height = 24;
         pane.settings_mut().samples_per_pixel = Some(1);
@@ -327,5 +331,5 @@ fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
     app.restart_all();
     let mut harness =
         Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app);
-    step_until(&mut harness, |app| app.panes().iter().all(|p| p.state().finished));
+    step_until(&mut harness, |app| app.panes().list().iter().all(|p| p.state().finished));
 }

@@ -24,6 +24,15 @@ pub struct ScreenshotRequest {
 }
 
 impl ScreenshotRequest {
+    /// A screenshot the user asked for from a dialog, taken a few frames
+    /// later (once the dialog is gone); refused unless it is a PNG.
+    pub fn asked(path: PathBuf, crop: Option<egui::Rect>) -> Result<Self, String> {
+        if !matches!(ImageFormat::of(&path), Ok(ImageFormat::Png)) {
+            return Err(format!("{}: screenshots are PNG files (end the name in .png)", path.display()));
+        }
+        Ok(Self::new(path, crop))
+    }
+
     pub fn new(path: PathBuf, crop: Option<egui::Rect>) -> Self {
         Self {
             path,
@@ -64,6 +73,56 @@ impl ScreenshotRequest {
             ctx.request_repaint();
         }
         outcome.map(|saved| saved.map(|()| self.path.clone()))
+    }
+}
+
+/// The screenshot on its way, if any, and where a failed headless one
+/// leaves its error for the binary to exit with.
+#[derive(Default)]
+pub struct Capture {
+    request: Option<ScreenshotRequest>,
+    exit_error: Arc<Mutex<Option<String>>>,
+}
+
+/// A screenshot done: where it went or why it failed, and whether to quit.
+pub struct Captured {
+    pub result: Result<PathBuf, String>,
+    pub quit: bool,
+}
+
+impl Capture {
+    /// `--screenshot PATH`: once every pane has `passes` passes, then quit.
+    pub fn headless(path: PathBuf, passes: u32) -> Self {
+        let request = ScreenshotRequest {
+            after_passes: Some(passes.max(1)),
+            quit_after: true,
+            delay: 0,
+            ..ScreenshotRequest::new(path, None)
+        };
+        Self { request: Some(request), ..Self::default() }
+    }
+
+    /// A screenshot the user asked for (see `ScreenshotRequest::asked`).
+    pub fn ask(&mut self, path: PathBuf, crop: Option<egui::Rect>) -> Result<(), String> {
+        self.request = Some(ScreenshotRequest::asked(path, crop)?);
+        Ok(())
+    }
+
+    pub fn exit_error(&self) -> Arc<Mutex<Option<String>>> {
+        self.exit_error.clone()
+    }
+
+    /// Advance one frame; `ready(n)` says whether every pane has n passes.
+    pub fn step(&mut self, ctx: &egui::Context, ready: impl Fn(u32) -> bool) -> Option<Captured> {
+        let request = self.request.as_mut()?;
+        let is_ready = request.after_passes.is_none_or(ready);
+        let result = request.step(ctx, is_ready)?;
+        let quit = request.quit_after;
+        self.request = None;
+        if let (Err(e), Ok(mut slot)) = (&result, self.exit_error.lock()) {
+            *slot = Some(e.clone());
+        }
+        Some(Captured { result, quit })
     }
 }
 

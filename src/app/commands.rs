@@ -43,3 +43,21 @@ pub enum Panel {
     Difference,
     Debug,
 }
+
+/// Which of the hideable panels are shown.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Shown {
+    pub plots: bool,
+    pub difference: bool,
+    pub debug: bool,
+}
+
+impl Shown {
+    pub fn set(&mut self, panel: Panel, on: bool) {
+        match panel {
+            Panel::Plots => self.plots = on,
+            Panel::Difference => self.difference = on,
+            Panel::Debug => self.debug = on,
+        }
+    }
+}

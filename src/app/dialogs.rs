@@ -26,8 +26,19 @@ impl Dialogs {
         Self { autosave_offer, ..Self::default() }
     }
 
-    pub fn open_file(&mut self, purpose: DialogPurpose, suggestion: &Path) {
-        self.file = Some(FileDialog::new(purpose, suggestion));
+    /// The file dialog for `purpose`, suggesting the document's own file
+    /// (`scene_path`) or a name that says what it is for.
+    pub fn open_file(&mut self, purpose: DialogPurpose, scene_path: Option<&Path>) {
+        let suggestion = match purpose {
+            DialogPurpose::OpenScene | DialogPurpose::SaveScene => {
+                scene_path.map_or_else(|| PathBuf::from("assets/scenes/untitled.ron"), Path::to_owned)
+            }
+            DialogPurpose::ExportPng => PathBuf::from("render.png"),
+            DialogPurpose::ExportExr => PathBuf::from("render.exr"),
+            DialogPurpose::Screenshot => PathBuf::from("screenshot.png"),
+            DialogPurpose::ComparisonSheet => PathBuf::from("comparison.png"),
+        };
+        self.file = Some(FileDialog::new(purpose, &suggestion));
     }
 
     pub fn ask_unsaved(&mut self, action: Action) {

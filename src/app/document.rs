@@ -10,7 +10,8 @@ use std::sync::Arc;
 use super::history::History;
 use crate::render::world::camera::CameraModel;
 use crate::render::world::World;
-use crate::scene::{save_scene, to_ron, Invalid, Scene, SceneFileError, ValidScene};
+use crate::scene::presets::default_scene;
+use crate::scene::{load_scene, save_scene, to_ron, Invalid, Scene, SceneFileError, ValidScene};
 
 pub struct Document {
     scene: Scene,
@@ -46,6 +47,16 @@ impl Document {
         };
         document.check();
         document
+    }
+
+    /// The document the studio opens on: `--scene`'s file, else the
+    /// built-in Cornell box (and why, if the file would not load).
+    pub fn starting(scene_file: Option<&Path>) -> (Self, Option<String>) {
+        match scene_file.map(|path| (path, load_scene(path))) {
+            Some((path, Ok(scene))) => (Self::new(scene.into_scene(), Some(path.to_owned()), true), None),
+            Some((_, Err(e))) => (Self::new(default_scene(), None, true), Some(e.to_string())),
+            None => (Self::new(default_scene(), None, true), None),
+        }
     }
 
     pub fn scene(&self) -> &Scene {
@@ -149,7 +160,6 @@ impl Document {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::presets::default_scene;
 
     #[test]
     fn revisions_track_edits_undo_returns_to_clean_and_checks_happen_once() {

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use eframe::egui;
 
-use super::commands::{Action, Command, Panel};
+use super::commands::{Action, Command, Panel, Shown};
 use super::files::DialogPurpose;
 use crate::scene::presets;
 
@@ -15,9 +15,7 @@ pub struct MenuView<'a> {
     pub can_redo: bool,
     pub recent: &'a [PathBuf],
     pub panes: usize,
-    pub plots: bool,
-    pub difference: bool,
-    pub debug: bool,
+    pub shown: Shown,
     /// The document's file, and whether it has unsaved edits.
     pub file: Option<(&'a Path, bool)>,
 }
@@ -45,9 +43,9 @@ pub fn menu_bar_ui(ui: &mut egui::Ui, view: &MenuView, commands: &mut Vec<Comman
             }
             ui.separator();
             for (panel, shown, label) in [
-                (Panel::Plots, view.plots, "Plots"),
-                (Panel::Difference, view.difference, "Difference view"),
-                (Panel::Debug, view.debug, "Debug overlay (frame time)"),
+                (Panel::Plots, view.shown.plots, "Plots"),
+                (Panel::Difference, view.shown.difference, "Difference view"),
+                (Panel::Debug, view.shown.debug, "Debug overlay (frame time)"),
             ] {
                 let mut on = shown;
                 if ui.checkbox(&mut on, label).changed() {

@@ -13,10 +13,12 @@ mod export;
 mod files;
 mod history;
 mod inspector;
+mod keys;
 mod menu;
 mod pane;
 mod panes;
 mod plots;
+mod status;
 mod storage;
 mod studio;
 mod viewport;
@@ -24,6 +26,8 @@ mod viewport;
 pub use commands::Action;
 pub use inspector::Selection;
 pub use pane::{Pane, PaneState, PassRecord};
+pub use panes::Panes;
+pub use status::Messages;
 pub use storage::Persisted;
 pub use studio::StudioApp;
 
@@ -86,7 +90,7 @@ pub fn run(args: StudioArgs) -> anyhow::Result<()> {
         options,
         Box::new(|cc| {
             let mut app = StudioApp::new(&cc.egui_ctx, state.as_ref().map(|s| s as &dyn eframe::Storage), &args);
-            app.notice(notice.unwrap_or_default());
+            app.notice(&notice.unwrap_or_default());
             if let Some(file) = state {
                 app.keep_state_in(file);
             }

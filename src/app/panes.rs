@@ -3,6 +3,7 @@
 //! together when the scene changes, and measured against the scene's
 //! reference.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use eframe::egui;
@@ -12,7 +13,7 @@ use super::inspector::Selection;
 use super::pane::Pane;
 use super::viewport::viewport_ui;
 use crate::render::{Algorithm, LinearImage, RenderSettings};
-use crate::scene::{SceneSettings, ValidScene};
+use crate::scene::{presets, Scene, SceneSettings, ValidScene};
 
 pub struct Panes {
     list: Vec<Pane>,
@@ -123,8 +124,12 @@ impl Panes {
         self.reference.as_ref()
     }
 
-    pub fn set_reference(&mut self, reference: Option<LinearImage>) {
-        self.reference = reference;
+    /// The stored reference of the preset `scene` is, if it is one: the
+    /// panes' error is measured against it where their size matches.
+    pub fn load_reference_for(&mut self, scene: &Scene) {
+        let name = presets::names().find(|n| presets::preset(n).and_then(Result::ok).is_some_and(|s| *s == *scene));
+        let path = |name: &str| PathBuf::from(format!("assets/references/{name}.exr"));
+        self.reference = name.and_then(|name| LinearImage::load(&path(name)).ok());
     }
 
     /// Take every pane's waiting events, measuring against the reference

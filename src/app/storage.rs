@@ -9,9 +9,12 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::pane::Pane;
+use super::panes::Panes;
 use crate::fileio::{self, FileError};
 use crate::limits;
 use crate::render::RenderSettings;
+use crate::scene::Scene;
 
 /// What survives a restart: the layout, each pane's settings, the files.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -27,6 +30,26 @@ impl Default for Persisted {
     fn default() -> Self {
         Self { panes: Vec::new(), exposures: Vec::new(), show_plots: true, recent: Vec::new() }
     }
+}
+
+impl Persisted {
+    /// What the studio keeps of its panes, panels and recent files.
+    pub fn of(panes: &Panes, show_plots: bool, recent: &[PathBuf]) -> Self {
+        let panes = panes.list();
+        Self {
+            panes: panes.iter().map(|p| p.settings().clone()).collect(),
+            exposures: panes.iter().map(Pane::exposure).collect(),
+            show_plots,
+            recent: recent.to_vec(),
+        }
+    }
+}
+
+/// `path` first among the recent files, once, and no more of them than kept.
+pub fn remember(recent: &mut Vec<PathBuf>, path: &Path) {
+    recent.retain(|p| p != path);
+    recent.insert(0, path.to_owned());
+    recent.truncate(RECENT_FILES);
 }
 
 /// Saved state made safe to start from: a pane whose saved settings break
@@ -133,6 +156,84 @@ impl eframe::Storage for StateFile {
 
     /// The studio calls `write`, which reports its error.
     fn flush(&mut self) {}
+}
+
+/// The two keys of the studio's state.
+const STATE_KEY: &str = "studio";
+const AUTOSAVE_KEY: &str = "autosave_scene";
+const SAVE_INTERVAL: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// What the autosave should hold after a save.
+pub enum Autosave {
+    /// Leave it as it is (a crashed session's scene is still on offer).
+    Keep,
+    /// No unsaved edits: nothing to offer back.
+    Clear,
+    Scene(String),
+}
+
+/// The saved layout and the autosaved scene, as a start reads them.
+pub fn read_state(storage: Option<&dyn eframe::Storage>) -> (Restored, Option<String>) {
+    let persisted: Persisted =
+        storage.and_then(|s| s.get_string(STATE_KEY)).and_then(|text| ron::from_str(&text).ok()).unwrap_or_default();
+    let autosave = storage.and_then(|s| s.get_string(AUTOSAVE_KEY)).filter(|t| !t.is_empty());
+    (persisted.restore(), autosave)
+}
+
+/// The autosaved scene, if it parses and differs from `scene`: what a
+/// crashed session left unsaved.
+pub fn autosave_offer(autosaved: Option<String>, scene: &Scene) -> Option<Scene> {
+    let valid = crate::scene::parse_scene(&autosaved?, Path::new("autosave.ron")).ok()?;
+    Some(valid.into_scene()).filter(|s| s != scene)
+}
+
+/// Put the layout and the autosave into `storage`.
+pub fn write_state(storage: &mut dyn eframe::Storage, persisted: &Persisted, autosave: Autosave) -> Result<(), String> {
+    let text = ron::to_string(persisted).map_err(|e| format!("could not save the studio's layout: {e}"))?;
+    storage.set_string(STATE_KEY, text);
+    match autosave {
+        Autosave::Keep => {}
+        Autosave::Clear => storage.set_string(AUTOSAVE_KEY, String::new()),
+        Autosave::Scene(text) => storage.set_string(AUTOSAVE_KEY, text),
+    }
+    Ok(())
+}
+
+/// The state file and when it was last written: every ten seconds, and on
+/// exit; never by a `--screenshot` run, which only reads it.
+pub struct StateKeeper {
+    file: Option<StateFile>,
+    last_write: std::time::Instant,
+    read_only: bool,
+}
+
+impl StateKeeper {
+    pub fn new(read_only: bool) -> Self {
+        Self { file: None, last_write: std::time::Instant::now(), read_only }
+    }
+
+    pub fn keep_in(&mut self, file: StateFile) {
+        self.file = Some(file);
+    }
+
+    pub fn read_only(&self) -> bool {
+        self.read_only
+    }
+
+    pub fn due(&self) -> bool {
+        self.last_write.elapsed() >= SAVE_INTERVAL
+    }
+
+    /// Fill the file through `save` (the studio's `App::save`) and write it.
+    pub fn write(&mut self, save: impl FnOnce(&mut dyn eframe::Storage)) -> Result<(), String> {
+        self.last_write = std::time::Instant::now();
+        let Some(file) = &mut self.file else { return Ok(()) };
+        save(file);
+        if self.read_only {
+            return Ok(());
+        }
+        file.write().map_err(|e| format!("could not save the studio's state: {e}"))
+    }
 }
 
 #[cfg(test)]

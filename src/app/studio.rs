@@ -6,119 +6,74 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
 
 use eframe::egui;
 
-use super::capture::ScreenshotRequest;
-use super::commands::{Action, Command, Panel};
+use super::capture::Capture;
+use super::commands::{Action, Command, Shown};
 use super::dialogs::Dialogs;
 use super::difference::Difference;
 use super::document::Document;
 use super::export::export_image;
 use super::files::DialogPurpose;
 use super::inspector::{inspector_ui, Selection};
+use super::keys::{input_commands, WindowState};
 use super::menu::{menu_bar_ui, MenuView};
-use super::pane::Pane;
 use super::panes::{pane_count, Panes};
 use super::plots::plots_ui;
-use super::storage::{Persisted, StateFile};
+use super::status::{FrameClock, Messages};
+use super::storage::{autosave_offer, read_state, remember, write_state, Autosave, Persisted, StateFile, StateKeeper};
 use super::StudioArgs;
-use crate::render::image::ImageFormat;
-use crate::render::LinearImage;
-use crate::scene::{load_scene, parse_scene, presets, Scene};
-
-const STATE_KEY: &str = "studio";
-const AUTOSAVE_KEY: &str = "autosave_scene";
-const STATE_SAVE_INTERVAL: Duration = Duration::from_secs(10);
-const RECENT_FILES: usize = 8;
+use crate::scene::{load_scene, presets, Scene};
 
 pub struct StudioApp {
     document: Document,
     panes: Panes,
     selection: Selection,
     dialogs: Dialogs,
-    screenshot: Option<ScreenshotRequest>,
+    capture: Capture,
     difference: Difference,
-    show_plots: bool,
-    show_difference: bool,
-    show_debug: bool,
+    shown: Shown,
     recent: Vec<PathBuf>,
-    /// The last error to show the user (bad file, failed save…), and news.
-    error: Option<String>,
-    status: String,
+    messages: Messages,
     quit_confirmed: bool,
-    /// A `--screenshot` run: it saves no state and never touches the autosave.
-    capture_only: bool,
-    state_file: Option<StateFile>,
-    last_state_save: Instant,
-    last_frame: Option<Instant>,
-    frame_ms: f32,
+    state: StateKeeper,
+    clock: FrameClock,
     paused: bool,
     ctx: egui::Context,
-    exit_error: Arc<Mutex<Option<String>>>,
 }
 
 impl StudioApp {
     /// Build the studio; `storage` restores layout, settings and recent
     /// files (checked: a bad saved value falls back with a notice).
     pub fn new(ctx: &egui::Context, storage: Option<&dyn eframe::Storage>, args: &StudioArgs) -> Self {
-        let saved: Persisted = storage
-            .and_then(|s| s.get_string(STATE_KEY))
-            .and_then(|text| ron::from_str(&text).ok())
-            .unwrap_or_default();
-        let restored = saved.restore();
-        let mut error = None;
-        let (scene, path) = match &args.scene {
-            Some(path) => match load_scene(path) {
-                Ok(scene) => (scene.into_scene(), Some(path.clone())),
-                Err(e) => {
-                    error = Some(e.to_string());
-                    (presets::default_scene(), None)
-                }
-            },
-            None => (presets::default_scene(), None),
-        };
+        let (restored, autosaved) = read_state(storage);
+        let (document, error) = Document::starting(args.scene.as_deref());
         let capture_only = args.screenshot.is_some();
-        let autosave_offer = (storage.and_then(|s| s.get_string(AUTOSAVE_KEY)))
-            .and_then(|text| parse_scene(&text, Path::new("autosave.ron")).ok())
-            .map(|valid| valid.into_scene())
-            .filter(|s| *s != scene && !capture_only);
+        let autosave_offer = autosave_offer(autosaved, document.scene()).filter(|_| !capture_only);
         let count = pane_count(args.panes.unwrap_or(restored.panes.len().max(1)));
         let mut app = Self {
             panes: Panes::new(ctx),
-            document: Document::new(scene, path, true),
+            document,
             selection: Selection::Camera,
             dialogs: Dialogs::new(autosave_offer),
-            screenshot: None,
+            capture: args
+                .screenshot
+                .clone()
+                .map_or_else(Capture::default, |path| Capture::headless(path, args.quit_after_passes)),
             difference: Difference::default(),
-            show_plots: restored.show_plots,
-            show_difference: false,
-            show_debug: false,
+            shown: Shown { plots: restored.show_plots, ..Shown::default() },
             recent: restored.recent,
-            error,
-            status: restored.notices.join("; "),
+            messages: Messages { error, status: restored.notices.join("; ") },
             quit_confirmed: false,
-            capture_only,
-            state_file: None,
-            last_state_save: Instant::now(),
-            last_frame: None,
-            frame_ms: 0.0,
+            state: StateKeeper::new(capture_only),
+            clock: FrameClock::default(),
             paused: false,
             ctx: ctx.clone(),
-            exit_error: Arc::new(Mutex::new(None)),
         };
         let saved_panes = if args.panes.is_none() { restored.panes } else { Vec::new() };
         app.panes.build(count, &saved_panes, &restored.exposures, &app.document.scene().settings);
         app.restart_all();
-        if let Some(path) = &args.screenshot {
-            app.screenshot = Some(ScreenshotRequest {
-                after_passes: Some(args.quit_after_passes.max(1)),
-                quit_after: true,
-                delay: 0,
-                ..ScreenshotRequest::new(path.clone(), None)
-            });
-        }
         app
     }
 
@@ -134,29 +89,21 @@ impl StudioApp {
         self.document.changed();
     }
 
-    pub fn panes(&self) -> &[Pane] {
-        self.panes.list()
+    pub fn panes(&self) -> &Panes {
+        &self.panes
     }
 
-    pub fn panes_mut(&mut self) -> &mut [Pane] {
-        self.panes.list_mut()
-    }
-
-    /// Where each pane's image was drawn last frame (screen points).
-    pub fn viewport_rects(&self) -> &[egui::Rect] {
-        self.panes.rects()
+    pub fn panes_mut(&mut self) -> &mut Panes {
+        &mut self.panes
     }
 
     pub fn selection(&self) -> Selection {
         self.selection
     }
 
-    pub fn error(&self) -> Option<&str> {
-        self.error.as_deref()
-    }
-
-    pub fn status(&self) -> &str {
-        &self.status
+    /// What the status bar says: the last error (bad file, failed save…), or news.
+    pub fn messages(&self) -> &Messages {
+        &self.messages
     }
 
     /// Whether rendering is paused (the window is minimised).
@@ -169,30 +116,19 @@ impl StudioApp {
         self.dialogs.offers_autosave()
     }
 
-    /// The generation each pane is rendering (tests watch restarts with it).
-    pub fn generations(&self) -> Vec<u64> {
-        self.panes.generations()
-    }
-
     /// The slot where a failed headless screenshot leaves its error.
     pub fn exit_error(&self) -> Arc<Mutex<Option<String>>> {
-        self.exit_error.clone()
+        self.capture.exit_error()
     }
 
     /// Keep the state in `file`: written every few seconds and on exit.
     pub fn keep_state_in(&mut self, file: StateFile) {
-        self.state_file = Some(file);
+        self.state.keep_in(file);
     }
 
     /// Add a line to the status bar.
-    pub fn notice(&mut self, message: String) {
-        if message.is_empty() {
-            return;
-        }
-        if !self.status.is_empty() {
-            self.status += "; ";
-        }
-        self.status += &message;
+    pub fn notice(&mut self, message: &str) {
+        self.messages.notice(message);
     }
 
     /// Render every pane afresh with the scene as it stands (after their
@@ -202,7 +138,7 @@ impl StudioApp {
         if let Some(scene) = self.document.valid().cloned() {
             self.panes.restart_all(&scene);
         }
-        self.load_reference();
+        self.panes.load_reference_for(self.document.scene());
     }
 
     /// Open a scene file; a broken one leaves the scene being edited as it was.
@@ -210,21 +146,19 @@ impl StudioApp {
         match load_scene(path) {
             Ok(scene) => {
                 self.replace_scene(scene.into_scene(), Some(path.to_owned()), true);
-                self.remember(path);
-                self.error = None;
-                self.status = format!("Opened {}", path.display());
+                remember(&mut self.recent, path);
+                self.messages.error = None;
+                self.messages.say(format!("Opened {}", path.display()));
             }
-            Err(e) => self.error = Some(e.to_string()),
+            Err(e) => self.messages.fail(e),
         }
     }
 
     /// Save pane `index`'s current image (.png tone-mapped, .exr linear).
     pub fn export_pane(&mut self, index: usize, path: &Path) {
         let Some(pane) = self.panes.list().get(index) else { return };
-        match export_image(&pane.state().image, pane.exposure(), path) {
-            Ok(()) => self.status = format!("Exported {}", path.display()),
-            Err(e) => self.error = Some(e.to_string()),
-        }
+        let exported = export_image(&pane.state().image, pane.exposure(), path);
+        self.messages.report(exported, || format!("Exported {}", path.display()));
     }
 
     // ---- Commands ------------------------------------------------------------
@@ -249,9 +183,7 @@ impl StudioApp {
                 self.restart_all();
             }
             Command::SetPanes(_) => {}
-            Command::Show(Panel::Plots, on) => self.show_plots = on,
-            Command::Show(Panel::Difference, on) => self.show_difference = on,
-            Command::Show(Panel::Debug, on) => self.show_debug = on,
+            Command::Show(panel, on) => self.shown.set(panel, on),
             Command::RestoreAutosave => {
                 if let Some(scene) = self.dialogs.take_autosave() {
                     // Restored, not saved: it stays an unsaved edit until saved
@@ -267,10 +199,10 @@ impl StudioApp {
             Action::NewFromPreset(name) => match presets::preset(&name) {
                 Some(Ok(scene)) => {
                     self.replace_scene(scene.into_scene(), None, true);
-                    self.status = format!("New scene from the {name} preset");
+                    self.messages.say(format!("New scene from the {name} preset"));
                 }
-                Some(Err(e)) => self.error = Some(e.to_string()),
-                None => self.error = Some(format!("no preset called {name}")),
+                Some(Err(e)) => self.messages.fail(e),
+                None => self.messages.fail(format!("no preset called {name}")),
             },
             Action::Open(path) => self.open_path(&path),
             Action::Quit => {
@@ -287,12 +219,6 @@ impl StudioApp {
         self.restart_all();
     }
 
-    fn remember(&mut self, path: &Path) {
-        self.recent.retain(|p| p != path);
-        self.recent.insert(0, path.to_owned());
-        self.recent.truncate(RECENT_FILES);
-    }
-
     fn save_or_ask(&mut self) {
         match self.document.path().map(Path::to_owned) {
             Some(path) => self.save_to(&path),
@@ -301,26 +227,15 @@ impl StudioApp {
     }
 
     fn save_to(&mut self, path: &Path) {
-        match self.document.save_to(path) {
-            Ok(()) => {
-                self.remember(path);
-                self.status = format!("Saved {}", path.display());
-            }
-            Err(e) => self.error = Some(e.to_string()),
+        let saved = self.document.save_to(path);
+        if saved.is_ok() {
+            remember(&mut self.recent, path);
         }
+        self.messages.report(saved, || format!("Saved {}", path.display()));
     }
 
     fn open_dialog(&mut self, purpose: DialogPurpose) {
-        let suggestion = match purpose {
-            DialogPurpose::OpenScene | DialogPurpose::SaveScene => {
-                self.document.path().map_or_else(|| PathBuf::from("assets/scenes/untitled.ron"), Path::to_owned)
-            }
-            DialogPurpose::ExportPng => PathBuf::from("render.png"),
-            DialogPurpose::ExportExr => PathBuf::from("render.exr"),
-            DialogPurpose::Screenshot => PathBuf::from("screenshot.png"),
-            DialogPurpose::ComparisonSheet => PathBuf::from("comparison.png"),
-        };
-        self.dialogs.open_file(purpose, &suggestion);
+        self.dialogs.open_file(purpose, self.document.path());
     }
 
     /// Act on a path the file dialog chose.
@@ -335,55 +250,26 @@ impl StudioApp {
     }
 
     /// Save the window (or, for the comparison sheet, the panes' area with
-    /// their labels) as PNG at the next frame.
+    /// their labels) as PNG a few frames on.
     fn take_screenshot(&mut self, path: PathBuf, crop: Option<egui::Rect>) {
-        if !matches!(ImageFormat::of(&path), Ok(ImageFormat::Png)) {
-            self.error = Some(format!("{}: screenshots are PNG files (end the name in .png)", path.display()));
-            return;
+        if let Err(e) = self.capture.ask(path, crop) {
+            self.messages.fail(e);
         }
-        self.screenshot = Some(ScreenshotRequest::new(path, crop));
-    }
-
-    /// The preset's stored reference, used for the panes' error when their
-    /// size is a whole multiple of it.
-    fn load_reference(&mut self) {
-        let scene = self.document.scene();
-        let name = presets::names().find(|n| presets::preset(n).and_then(Result::ok).is_some_and(|s| *s == *scene));
-        let reference =
-            name.and_then(|name| LinearImage::load(Path::new(&format!("assets/references/{name}.exr"))).ok());
-        self.panes.set_reference(reference);
     }
 
     // ---- The frame -----------------------------------------------------------
 
-    fn input_commands(&mut self, ctx: &egui::Context, commands: &mut Vec<Command>) {
-        use egui::{Key, KeyboardShortcut, Modifiers};
-        let shortcut = |modifiers, key| ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(modifiers, key)));
-        if shortcut(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z) {
-            commands.push(Command::Redo);
-        } else if shortcut(Modifiers::COMMAND, Key::Z) {
-            commands.push(Command::Undo);
-        }
-        if shortcut(Modifiers::COMMAND, Key::S) {
-            commands.push(Command::Save);
-        }
-        if shortcut(Modifiers::COMMAND, Key::O) {
-            commands.push(Command::OpenDialog(DialogPurpose::OpenScene));
-        }
-        let dropped: Vec<PathBuf> = ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_owned()).collect());
-        if let Some(path) = dropped.into_iter().find(|p| p.extension().is_some_and(|e| e == "ron")) {
-            commands.push(Command::Request(Action::Open(path)));
-        }
-        if ctx.input(|i| i.viewport().close_requested()) && self.document.is_dirty() && !self.quit_confirmed {
+    /// A close asked for with unsaved edits waits for the user's answer;
+    /// rendering pauses while the window is minimised.
+    fn window_events(&mut self, ctx: &egui::Context, window: WindowState) {
+        if window.close_requested && self.document.is_dirty() && !self.quit_confirmed {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
             self.dialogs.ask_unsaved(Action::Quit);
         }
-        // Rendering pauses while the window is minimised
-        let minimised = ctx.input(|i| i.viewport().minimized).unwrap_or(false);
-        if minimised && !self.paused {
+        if window.minimised && !self.paused {
             self.panes.pause_all();
             self.paused = true;
-        } else if !minimised && self.paused {
+        } else if !window.minimised && self.paused {
             self.paused = false;
             self.restart_all();
         }
@@ -392,14 +278,11 @@ impl StudioApp {
     /// One frame of the whole studio.
     pub fn show(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
-        let now = Instant::now();
-        if let Some(last) = self.last_frame {
-            self.frame_ms = 0.9 * self.frame_ms + 0.1 * (now - last).as_secs_f32() * 1e3;
-        }
-        self.last_frame = Some(now);
+        self.clock.tick();
         self.panes.poll();
         let mut commands = Vec::new();
-        self.input_commands(&ctx, &mut commands);
+        let window = input_commands(&ctx, &mut commands);
+        self.window_events(&ctx, window);
 
         egui::Panel::top("menu").show(ui, |ui| {
             let view = MenuView {
@@ -407,21 +290,19 @@ impl StudioApp {
                 can_redo: self.document.can_redo(),
                 recent: &self.recent,
                 panes: self.panes.count(),
-                plots: self.show_plots,
-                difference: self.show_difference,
-                debug: self.show_debug,
+                shown: self.shown,
                 file: self.document.path().map(|p| (p, self.document.is_dirty())),
             };
             menu_bar_ui(ui, &view, &mut commands);
         });
-        self.status_ui(ui);
+        self.messages.status_ui(ui);
         egui::Panel::left("inspector").resizable(true).default_size(330.0).show(ui, |ui| {
             let problems = self.document.problems().to_vec();
             if inspector_ui(ui, self.document.scene_mut(), &mut self.selection, &problems) {
                 self.document.changed();
             }
         });
-        if self.show_plots {
+        if self.shown.plots {
             egui::Panel::bottom("plots")
                 .resizable(true)
                 .default_size(200.0)
@@ -429,7 +310,7 @@ impl StudioApp {
         }
         egui::CentralPanel::default().show(ui, |ui| self.panes.panes_ui(ui, &mut self.document, &mut self.selection));
         self.dialogs.dialogs_ui(&ctx, self.document.path(), &mut commands);
-        if self.show_difference {
+        if self.shown.difference {
             self.difference.difference_ui(&ctx, &self.panes);
         }
         for command in commands {
@@ -440,61 +321,28 @@ impl StudioApp {
         if let Some(scene) = self.document.check() {
             if !self.paused {
                 self.panes.restart_all(&scene);
-                self.load_reference();
+                self.panes.load_reference_for(self.document.scene());
             }
         }
         self.capture_step(&ctx);
-        if self.last_state_save.elapsed() >= STATE_SAVE_INTERVAL {
+        if self.state.due() {
             if let Err(e) = self.save_state() {
-                self.error = Some(e);
+                self.messages.fail(e);
             }
         }
-        if self.show_debug {
-            self.debug_ui(&ctx);
+        if self.shown.debug {
+            self.clock.debug_ui(&ctx);
         }
-    }
-
-    fn status_ui(&mut self, ui: &mut egui::Ui) {
-        egui::Panel::bottom("status").show(ui, |ui| {
-            ui.horizontal(|ui| match &self.error {
-                Some(error) => {
-                    ui.colored_label(ui.visuals().error_fg_color, error);
-                    if ui.small_button("Dismiss").clicked() {
-                        self.error = None;
-                    }
-                }
-                None => {
-                    ui.label(&self.status);
-                }
-            });
-        });
-    }
-
-    fn debug_ui(&self, ctx: &egui::Context) {
-        let area = egui::Area::new(egui::Id::unique("debug")).anchor(egui::Align2::RIGHT_TOP, egui::vec2(-8.0, 28.0));
-        area.show(ctx, |ui| {
-            let text = egui::RichText::new(format!("UI frame {:.1} ms", self.frame_ms)).monospace();
-            ui.label(text.background_color(egui::Color32::from_black_alpha(180)));
-        });
-        ctx.request_repaint();
     }
 
     fn capture_step(&mut self, ctx: &egui::Context) {
-        let Some(shot) = &mut self.screenshot else { return };
-        let ready = shot.after_passes.is_none_or(|n| self.panes.all_have(n));
-        let Some(outcome) = shot.step(ctx, ready) else { return };
-        let quit = shot.quit_after;
-        self.screenshot = None;
-        match outcome {
-            Ok(path) => self.status = format!("Saved {}", path.display()),
-            Err(e) => {
-                self.error = Some(e.clone());
-                if let Ok(mut slot) = self.exit_error.lock() {
-                    *slot = Some(e);
-                }
-            }
+        let panes = &self.panes;
+        let Some(done) = self.capture.step(ctx, |passes| panes.all_have(passes)) else { return };
+        match done.result {
+            Ok(path) => self.messages.say(format!("Saved {}", path.display())),
+            Err(e) => self.messages.fail(e),
         }
-        if quit {
+        if done.quit {
             self.quit_confirmed = true;
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
@@ -502,24 +350,12 @@ impl StudioApp {
 
     // ---- What survives a restart ---------------------------------------------
 
-    pub fn persisted(&self) -> Persisted {
-        let panes = self.panes.list();
-        Persisted {
-            panes: panes.iter().map(|p| p.settings().clone()).collect(),
-            exposures: panes.iter().map(Pane::exposure).collect(),
-            show_plots: self.show_plots,
-            recent: self.recent.clone(),
-        }
-    }
-
     /// Write the state file (layout and autosave) if there is one.
     fn save_state(&mut self) -> Result<(), String> {
-        self.last_state_save = Instant::now();
-        let Some(mut file) = self.state_file.take() else { return Ok(()) };
-        eframe::App::save(self, &mut file);
-        let written = if self.capture_only { Ok(()) } else { file.write() };
-        self.state_file = Some(file);
-        written.map_err(|e| format!("could not save the studio's state: {e}"))
+        let mut state = std::mem::replace(&mut self.state, StateKeeper::new(true));
+        let written = state.write(|storage| eframe::App::save(self, storage));
+        self.state = state;
+        written
     }
 }
 
@@ -532,20 +368,21 @@ impl eframe::App for StudioApp {
     /// the last session's scene is offered back, its autosave stays as it is
     /// (a second crash must not lose it).
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        if self.capture_only {
+        if self.state.read_only() {
             return;
         }
-        match ron::to_string(&self.persisted()) {
-            Ok(text) => storage.set_string(STATE_KEY, text),
-            Err(e) => self.error = Some(format!("could not save the studio's layout: {e}")),
-        }
-        if self.dialogs.offers_autosave() {
-            return;
-        }
-        match self.document.autosave_text() {
-            None => storage.set_string(AUTOSAVE_KEY, String::new()),
-            Some(Ok(text)) => storage.set_string(AUTOSAVE_KEY, text),
-            Some(Err(e)) => self.error = Some(format!("could not autosave the scene: {e}")),
+        let autosave = match self.document.autosave_text() {
+            _ if self.dialogs.offers_autosave() => Autosave::Keep,
+            None => Autosave::Clear,
+            Some(Ok(text)) => Autosave::Scene(text),
+            Some(Err(e)) => {
+                self.messages.fail(format!("could not autosave the scene: {e}"));
+                Autosave::Keep
+            }
+        };
+        let persisted = Persisted::of(&self.panes, self.shown.plots, &self.recent);
+        if let Err(e) = write_state(storage, &persisted, autosave) {
+            self.messages.fail(e);
         }
     }
 
