@@ -1,5 +1,7 @@
 use glam::Vec3;
 
+use super::real::{Real, V3};
+
 /// An orthonormal basis around a unit normal, for turning local sample
 /// directions (z up) into world space.
 #[derive(Clone, Copy, Debug)]
@@ -14,12 +16,8 @@ impl Frame {
     /// and continuous except at one pole.
     #[inline]
     pub fn from_z(z: Vec3) -> Self {
-        let sign = 1.0f32.copysign(z.z);
-        let a = -1.0 / (sign + z.z);
-        let b = z.x * z.y * a;
-        let x = Vec3::new(1.0 + sign * z.x * z.x * a, sign * b, -sign * z.x);
-        let y = Vec3::new(b, sign + z.y * z.y * a, -z.y);
-        Self { x, y, z }
+        let [x, y, _] = frame_from_z(V3::from(z));
+        Self { x: x.into(), y: y.into(), z }
     }
 
     #[inline]
@@ -31,6 +29,24 @@ impl Frame {
     pub fn to_local(&self, v: Vec3) -> Vec3 {
         Vec3::new(v.dot(self.x), v.dot(self.y), v.dot(self.z))
     }
+}
+
+/// An orthonormal basis [x, y, z] about the unit vector `z` (Duff et al.
+/// 2017: branchless, and continuous but for the sign of z.z).
+#[inline(always)]
+pub fn frame_from_z<R: Real>(z: V3<R>) -> [V3<R>; 3] {
+    let sign = R::splat(1.0).copysign(z.z);
+    let a = R::splat(-1.0) / (sign + z.z);
+    let b = z.x * z.y * a;
+    let x = V3::new(R::splat(1.0) + sign * z.x * z.x * a, sign * b, -sign * z.x);
+    let y = V3::new(b, sign + z.y * z.y * a, -z.y);
+    [x, y, z]
+}
+
+/// `v` (in the frame's coordinates) in the world's.
+#[inline(always)]
+pub fn to_world<R: Real>(frame: [V3<R>; 3], v: V3<R>) -> V3<R> {
+    frame[0] * v.x + frame[1] * v.y + frame[2] * v.z
 }
 
 #[cfg(test)]

@@ -5,19 +5,21 @@
 mod frame;
 mod plane;
 mod ray;
-mod sphere;
+pub mod real;
+pub mod sphere;
 mod triangle;
 
-pub use frame::Frame;
+pub use frame::{frame_from_z, to_world, Frame};
 pub use plane::intersect_plane;
 pub(crate) use plane::{plane_hit, plane_t};
-pub use ray::{gamma, offset_ray_origin, Ray};
+pub use ray::{gamma, offset_origin, offset_ray_origin, spawn_offset_scale, Ray};
 pub use sphere::intersect_sphere;
 pub(crate) use sphere::sphere_hit;
 pub use sphere::sphere_t;
 pub use triangle::{intersect_triangle, Triangle};
 
 use glam::Vec3;
+use real::{Real, V3};
 
 /// A surface point found by a ray: where, how far, which way the surface faces,
 /// and how far the computed point may be from the true surface.
@@ -47,12 +49,19 @@ impl SurfaceHit {
     /// shadow tests; the target's own error bound keeps it off the far surface.
     #[inline]
     pub fn spawn_ray_to(&self, target: Vec3, target_error: f32) -> (Ray, f32) {
-        let direction = target - self.point;
-        let origin = offset_ray_origin(self.point, self.error, self.normal, direction);
-        let to_target = target - origin;
-        let distance = to_target.length();
-        let direction = to_target / distance;
-        let margin = target_error.max(ray::spawn_offset_scale(target)) * 4.0;
-        (Ray::new(origin, direction), (distance - margin).max(0.0))
+        let (origin, direction, t_max) =
+            ray_to(self.point.into(), self.error, self.normal.into(), target.into(), target_error);
+        (Ray::new(origin.into(), direction.into()), t_max)
     }
+}
+
+/// `SurfaceHit::spawn_ray_to` for one point or several: (origin, unit
+/// direction, t_max).
+#[inline(always)]
+pub fn ray_to<R: Real>(point: V3<R>, error: R, normal: V3<R>, target: V3<R>, target_error: R) -> (V3<R>, V3<R>, R) {
+    let origin = ray::offset_origin(point, error, normal, target - point);
+    let to_target = target - origin;
+    let distance = to_target.length();
+    let margin = target_error.max(ray::spawn_offset_scale(target)) * 4.0;
+    (origin, to_target / distance, (distance - margin).max(R::splat(0.0)))
 }

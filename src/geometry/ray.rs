@@ -1,5 +1,7 @@
 use glam::Vec3;
 
+use super::real::{Real, V3};
+
 /// A ray `x(t) = origin + t·direction`, `direction` unit length, `t ≥ 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
@@ -31,12 +33,12 @@ pub const fn gamma(n: u32) -> f32 {
 /// its largest coordinate (Wächter & Binder, Ray Tracing Gems ch. 6). Their
 /// fixed floor near the origin is dropped: each shape reports its own error
 /// bound, so the offset can stay relative and tiny scenes keep working.
-#[inline]
-pub(crate) fn spawn_offset_scale(p: Vec3) -> f32 {
+#[inline(always)]
+pub fn spawn_offset_scale<R: Real>(p: V3<R>) -> R {
     const ULPS: f32 = 256.0;
-    let m = p.abs().max_element().max(f32::MIN_POSITIVE);
+    let m = p.abs().max_element().max(R::splat(f32::MIN_POSITIVE));
     // ulp(m) from the exponent: exact and cheap
-    let ulp = f32::from_bits((m.to_bits() & 0x7f80_0000).saturating_sub(23 << 23)).max(f32::from_bits(1));
+    let ulp = m.binade_ulp().max(R::splat(f32::from_bits(1)));
     ulp * ULPS
 }
 
@@ -46,8 +48,14 @@ pub(crate) fn spawn_offset_scale(p: Vec3) -> f32 {
 /// on large scenes, light leaks through thin shells on small ones.
 #[inline]
 pub fn offset_ray_origin(point: Vec3, error: f32, normal: Vec3, direction: Vec3) -> Vec3 {
+    offset_origin(point.into(), error, normal.into(), direction.into()).into()
+}
+
+/// `offset_ray_origin` for one point or several.
+#[inline(always)]
+pub fn offset_origin<R: Real>(point: V3<R>, error: R, normal: V3<R>, direction: V3<R>) -> V3<R> {
     let distance = error * normal.abs().element_sum() + spawn_offset_scale(point);
-    let offset = if direction.dot(normal) < 0.0 { -normal * distance } else { normal * distance };
+    let offset = V3::select(direction.dot(normal).lt(R::splat(0.0)), -normal * distance, normal * distance);
     point + offset
 }
 
@@ -57,11 +65,10 @@ mod tests {
 
     #[test]
     fn offset_scale_grows_with_magnitude() {
-        let small = spawn_offset_scale(Vec3::splat(1.0));
-        let large = spawn_offset_scale(Vec3::splat(1.0e6));
-        assert!(large > small * 1.0e5);
-        assert!(spawn_offset_scale(Vec3::ZERO) > 0.0);
-        assert!(spawn_offset_scale(Vec3::splat(1e-8)) < 1e-12);
+        let scale = |v: f32| spawn_offset_scale(V3::from(Vec3::splat(v)));
+        assert!(scale(1.0e6) > scale(1.0) * 1.0e5);
+        assert!(scale(0.0) > 0.0);
+        assert!(scale(1e-8) < 1e-12);
     }
 
     #[test]

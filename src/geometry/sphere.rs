@@ -1,5 +1,6 @@
 use glam::Vec3;
 
+use super::real::{Mask, Real, V3};
 use super::{gamma, Ray, SurfaceHit};
 
 /// Nearest hit of `ray` with the sphere in (0, t_max).
@@ -19,31 +20,37 @@ pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32, t_max: f32) -> Opt
 /// Which root matters: from far away both round to the same `t`.
 #[inline]
 pub fn sphere_t(ray: &Ray, center: Vec3, radius: f32, t_max: f32) -> Option<(f32, bool)> {
-    // Compute the quadratic's terms relative to the closest approach
-    let f = ray.origin - center;
-    let b = f.dot(ray.direction);
-    let closest = f - b * ray.direction;
-    let r2 = radius * radius;
-    let discriminant = r2 - closest.length_squared();
-    if discriminant < 0.0 {
-        return None;
-    }
-    let c = f.length_squared() - r2;
-    // Take the root that adds magnitudes, then the other from Vieta (t0·t1 = c)
-    let q = -b - discriminant.sqrt().copysign(b);
-    let (mut t0, mut t1) = (c / q, q);
-    if t0 > t1 {
-        std::mem::swap(&mut t0, &mut t1);
-    }
-    if t0 > 0.0 && t0 < t_max {
-        Some((t0, true))
-    } else if t1 > 0.0 && t1 < t_max {
-        Some((t1, false))
-    } else {
-        // Includes q == 0 (a ray through the centre starting on it): t0 is NaN and
-        // every comparison is false.
-        None
-    }
+    let f = V3::from(ray.origin - center);
+    let (t, hit, near) = nearest_root(f, ray.direction.into(), radius * radius, t_max);
+    hit.then_some((t, near))
+}
+
+/// The roots of a sphere of squared radius `radius2` along rays of unit
+/// `direction`, from `f` = origin − centre: (near, far, discriminant). The
+/// discriminant comes from the closest approach, the root that adds
+/// magnitudes first and the other from Vieta (t0·t1 = c).
+#[inline(always)]
+pub fn roots<R: Real>(f: V3<R>, direction: V3<R>, radius2: R) -> (R, R, R) {
+    let b = f.dot(direction);
+    let closest = f - direction * b;
+    let discriminant = radius2 - closest.length_squared();
+    let c = f.length_squared() - radius2;
+    let q = -b - discriminant.max(R::splat(0.0)).sqrt().copysign(b);
+    let t0 = c / q;
+    (t0.min(q), t0.max(q), discriminant)
+}
+
+/// The nearest root in (0, t_max): (t, whether there is one, whether it is
+/// the near root). A ray starting inside takes the far root; q == 0 (a ray
+/// through the centre starting on it) gives NaN, which no comparison passes.
+#[inline(always)]
+pub fn nearest_root<R: Real>(f: V3<R>, direction: V3<R>, radius2: R, t_max: R) -> (R, R::Mask, R::Mask) {
+    let (near, far, discriminant) = roots(f, direction, radius2);
+    let zero = R::splat(0.0);
+    let near_ok = near.gt(zero).and(near.lt(t_max));
+    let t = R::select(near_ok, near, far);
+    let hit = discriminant.ge(zero).and(t.gt(zero)).and(t.lt(t_max));
+    (t, hit, near_ok)
 }
 
 #[inline]

@@ -9,37 +9,32 @@
 //! Rare cases (a BSDF-sampled ray reaching a light, lights other than a
 //! sphere's cap) call the scalar code for that lane.
 
-use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_4, PI};
+use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::{gamma, Ray, SurfaceHit};
-use crate::render::integrators::Counters;
+use super::Counters;
+use crate::geometry::sphere::{nearest_root, roots};
+use crate::geometry::{frame_from_z, gamma, offset_origin, ray_to, to_world, Ray, SurfaceHit};
+use crate::render::world::bsdf::{reflect_of, refraction_of, Bsdf, Refraction};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
-use crate::render::world::light::LightSource;
+use crate::render::world::light::{solid_angle_pdf_of, LightSource};
 use crate::render::world::rng::Sampler;
-use crate::render::world::sampling::{power_heuristic, ROUND_BY_ADDING};
+use crate::render::world::sampling::{cosine_hemisphere_of, power_heuristic, power_heuristic_of, uniform_cone_of};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::{MaterialModel, Rgb};
 
 /// Bounces before Russian roulette may end a path (as in `path`).
 const ROULETTE_DEPTH: u32 = crate::render::integrators::path::ROULETTE_DEPTH;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Kind {
-    Lambert,
-    Mirror,
-    Glass,
-    Emissive,
-}
-
-impl Kind {
-    /// The kind as a float, for comparing eight at a time.
-    fn code(self) -> F8 {
-        F8::splat(self as u8 as f32)
-    }
-}
+/// The `Bsdf` each sphere's lanes run, as a float to compare eight at a
+/// time (the lanes run these four; a scene with another model is traced by
+/// the scalar code).
+const LAMBERT: f32 = 0.0;
+const MIRROR: f32 = 1.0;
+const GLASS: f32 = 2.0;
+const EMITTER: f32 = 3.0;
 
 /// One sphere with what shading needs of its material.
 #[derive(Clone, Copy, Debug)]
@@ -50,7 +45,7 @@ struct SphereInfo {
     /// Bound on the error of points computed on it (as `sphere_hit` gives).
     error: f32,
     object: u32,
-    /// `Kind::code`
+    /// `LAMBERT`, `MIRROR`, `GLASS` or `EMITTER`.
     kind: f32,
     /// Albedo, tint or radiance.
     color: Rgb,
@@ -118,11 +113,12 @@ impl PathLanes {
             .map(|i| {
                 let object = s.object[i];
                 let (center, radius) = (s.center(i), s.radius[i]);
-                let (kind, color, ior) = match world.materials[world.objects[object as usize].material as usize] {
-                    MaterialModel::Lambert { albedo } => (Kind::Lambert, albedo, 1.0),
-                    MaterialModel::Mirror { tint } => (Kind::Mirror, tint, 1.0),
-                    MaterialModel::Glass { ior, tint } => (Kind::Glass, tint, ior),
-                    MaterialModel::Emissive { radiance } => (Kind::Emissive, radiance, 1.0),
+                let material = &world.materials[world.objects[object as usize].material as usize];
+                let (kind, color, ior) = match (Bsdf::new(material), material) {
+                    (Bsdf::Lambert { albedo }, _) => (LAMBERT, albedo, 1.0),
+                    (Bsdf::Mirror { tint }, _) => (MIRROR, tint, 1.0),
+                    (Bsdf::Glass { ior, tint }, _) => (GLASS, tint, ior),
+                    (Bsdf::Black, MaterialModel::Emissive { radiance }) => (EMITTER, *radiance, 1.0),
                     _ => return None,
                 };
                 Some(SphereInfo {
@@ -131,7 +127,7 @@ impl PathLanes {
                     radius2: radius * radius,
                     error: gamma(6) * (center.abs().max_element() + radius),
                     object,
-                    kind: kind as u8 as f32,
+                    kind,
                     color,
                     ior,
                 })
@@ -266,7 +262,8 @@ impl PathLanes {
         let mut index = F8::splat(0.0);
         let mut k = F8::splat(0.0);
         for sphere in &self.spheres {
-            let (t, closer) = roots(origin, direction, sphere.center, sphere.radius2, t_hit);
+            let f = origin - V8::splat(sphere.center);
+            let (t, closer, _) = nearest_root(f, direction, F8::splat(sphere.radius2), t_hit);
             t_hit = closer.select(t, t_hit);
             index = closer.select(k, index);
             k = k + 1.0;
@@ -286,9 +283,8 @@ impl PathLanes {
             lanes::each(|i| &self.spheres[index[i] as usize])
         };
         let code = F8::from_fn(|i| sphere[i].kind);
-        let kind = |k: Kind| code.eq(k.code()).and(alive);
-        let (lambert, mirror, glass, emissive) =
-            (kind(Kind::Lambert), kind(Kind::Mirror), kind(Kind::Glass), kind(Kind::Emissive));
+        let kind = |k: f32| code.eq(F8::splat(k)).and(alive);
+        let (lambert, mirror, glass, emissive) = (kind(LAMBERT), kind(MIRROR), kind(GLASS), kind(EMITTER));
         let color = V8::from_fn(|i| sphere[i].color);
 
         // The hit, rebuilt from the closest approach as `sphere_hit` does
@@ -297,7 +293,7 @@ impl PathLanes {
         let error = F8::from_fn(|i| sphere[i].error);
         let f = origin - center;
         // Which root `roots` took (solved again: cheaper than tracking it through the search)
-        let (near_root, _, discriminant) = solve(f, direction, radius * radius);
+        let (near_root, _, discriminant) = roots(f, direction, radius * radius);
         let near = near_root.gt(F8::splat(0.0));
         let closest = f - direction * f.dot(direction);
         let half_chord = discriminant.max(F8::splat(0.0)).sqrt();
@@ -355,7 +351,7 @@ impl PathLanes {
                 if lit.any() {
                     let cos = light.wi.dot(facing);
                     let bsdf_pdf = cos.max(zero) * FRAC_1_PI;
-                    let mis = power_heuristic8(pick_pdf * light.pdf, bsdf_pdf);
+                    let mis = power_heuristic_of(pick_pdf * light.pdf, bsdf_pdf);
                     let weight = light.delta.select(F8::splat(1.0), mis);
                     let term = st.throughput * f * light.value * (cos * weight / pick_pdf);
                     st.radiance = lit.select_v(st.radiance + term, st.radiance);
@@ -364,13 +360,13 @@ impl PathLanes {
         }
 
         // Scattering: each material draws what it uses (`Bsdf::sample`)
-        let mut wi = reflect(wo, facing);
+        let mut wi = reflect_of(wo, facing);
         let mut weight = color;
         let mut pdf = F8::splat(1.0);
         let mut scattered = mirror;
         if lambert.any() {
-            let local = cosine_hemisphere(st.rng.next_2d(lambert));
-            let w = to_world(from_z(facing), local);
+            let (u0, u1) = st.rng.next_2d(lambert);
+            let w = to_world(frame_from_z(facing), cosine_hemisphere_of(u0, u1));
             let cos = w.dot(facing);
             let ok = lambert.and(cos.gt(zero));
             wi = ok.select_v(w, wi);
@@ -382,14 +378,7 @@ impl PathLanes {
             let entering = wo.dot(normal).gt(zero);
             let eta_i = entering.select(F8::splat(1.0), ior);
             let eta_t = entering.select(ior, F8::splat(1.0));
-            let eta = eta_i / eta_t;
-            // `clamp(0, 1)`, NaN kept
-            let cos_i = F8::splat(1.0).min(zero.max(wo.dot(facing)));
-            let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-            let total = sin2_t.ge(F8::splat(1.0));
-            let cos_t = (1.0 - sin2_t).sqrt();
-            let fresnel = total.select(F8::splat(1.0), fresnel_dielectric(cos_i, cos_t, eta_i, eta_t));
-            let refracted = (wo * -eta + facing * (eta * cos_i - cos_t)).normalize();
+            let Refraction { fresnel, direction: refracted, eta, total } = refraction_of(wo, facing, eta_i, eta_t);
             let u_lobe = st.rng.next_f32(glass.and_not(total));
             let through = glass.and_not(total).and(u_lobe.ge(fresnel));
             let bounced = glass.and_not(through);
@@ -421,10 +410,17 @@ impl PathLanes {
             st.throughput = kept.select_v(st.throughput / survive, st.throughput);
         }
         let go = go.and_not(killed);
-        st.origin = go.select_v(offset_ray_origin(point, error, normal, wi), st.origin);
+        st.origin = go.select_v(offset_origin(point, error, normal, wi), st.origin);
         st.direction = go.select_v(wi, st.direction);
         st.depth = st.depth.count_in(go);
         done.or(killed).or(go.and(st.depth.ge(max_depth)))
+    }
+
+    /// Lanes whose segment (origin, unit direction, t_max) meets `sphere`.
+    #[inline(always)]
+    fn hits(sphere: &Occluder, origin: V8, direction: V8, t_max: F8) -> M8 {
+        let f = origin - V8::splat(sphere.center);
+        nearest_root(f, direction, F8::splat(sphere.radius2), t_max).1
     }
 
     /// Lanes of `mask` whose shadow ray (origin, unit direction, t_max) is
@@ -440,12 +436,12 @@ impl PathLanes {
                 Some(id) => M8::from_fn(|i| self.light_spheres[pick[i]] == Some(id)),
                 None => M8::NONE,
             };
-            blocked = blocked.or(roots(origin, direction, sphere.center, sphere.radius2, t_max).1.and_not(aimed_at));
+            blocked = blocked.or(Self::hits(sphere, origin, direction, t_max).and_not(aimed_at));
         }
         let outside = mask.and_not(inside_walls);
         if outside.any() {
             for sphere in &self.walls {
-                blocked = blocked.or(outside.and(roots(origin, direction, sphere.center, sphere.radius2, t_max).1));
+                blocked = blocked.or(outside.and(Self::hits(sphere, origin, direction, t_max)));
             }
         }
         mask.and(blocked)
@@ -527,7 +523,7 @@ impl CameraSamples {
             let (u0, u1) = rng.next_2d(M8::ALL);
             let film_x = F8::from_fn(|i| column[i] as f32) + u0;
             let film_y = F8::from_fn(|i| row[i] as f32) + u1;
-            let (origin, direction) = tile.camera.pinhole_rays(film_x, film_y);
+            let (origin, direction) = tile.camera.pinhole_rays_of(film_x, film_y);
             samples.push(origin, direction, rng.states());
         }
         samples
@@ -725,16 +721,11 @@ impl LightLanes {
             let CapLanes { center, radius, error: light_error, frame, one_minus_cos, area, radiance } = caps;
 
             // Uniform over the cap (`sample_area`)
-            let light_normal = to_world(frame, uniform_cone(u, one_minus_cos));
+            let light_normal = to_world(frame, uniform_cone_of(u.0, u.1, one_minus_cos));
             let target = center + light_normal * radius;
-            let pdf = solid_angle_pdf(point, target, light_normal, area);
+            let pdf = solid_angle_pdf_of(point, target, light_normal, area);
             // The shadow ray (`SurfaceHit::spawn_ray_to`)
-            let origin = offset_ray_origin(point, error, normal, target - point);
-            let to_target = target - origin;
-            let distance = to_target.length();
-            let wi = to_target / distance;
-            let margin = light_error.max(spawn_offset_scale(target)) * 4.0;
-            let t_max = (distance - margin).max(F8::splat(0.0));
+            let (origin, wi, t_max) = ray_to(point, error, normal, target, light_error);
             // Emission is one-sided: the light's front must face the point
             let faces = !light_normal.dot(-wi).le(F8::splat(0.0));
             let valid = cap_lanes.and(pdf.gt(F8::splat(0.0))).and(faces);
@@ -756,152 +747,6 @@ impl LightLanes {
         }
         out
     }
-}
-
-/// The roots of a sphere along the rays, (near, far, discriminant), from
-/// f = origin − center: `SphereLanes::group`'s arithmetic with the rays in
-/// the lanes.
-#[inline(always)]
-fn solve(f: V8, direction: V8, radius2: F8) -> (F8, F8, F8) {
-    let b = f.dot(direction);
-    let l = f - direction * b;
-    let discriminant = radius2 - l.length_squared();
-    let c = f.length_squared() - radius2;
-    let q = -b - discriminant.max(F8::splat(0.0)).sqrt().copysign(b);
-    let t0 = c / q;
-    (t0.min(q), t0.max(q), discriminant)
-}
-
-/// Per lane, the nearest root t of the sphere and whether it lies in
-/// (0, t_max) (t means nothing where not).
-#[inline(always)]
-fn roots(origin: V8, direction: V8, center: Vec3, radius2: f32, t_max: F8) -> (F8, M8) {
-    let (near, far, discriminant) = solve(origin - V8::splat(center), direction, F8::splat(radius2));
-    // The far root only where the near one is behind: beyond t_max, both are
-    let zero = F8::splat(0.0);
-    let t = near.gt(zero).select(near, far);
-    (t, discriminant.ge(zero).and(t.gt(zero)).and(t.lt(t_max)))
-}
-
-#[inline(always)]
-fn reflect(w: V8, n: V8) -> V8 {
-    n * (2.0 * w.dot(n)) - w
-}
-
-/// `power_heuristic` in lanes.
-#[inline(always)]
-fn power_heuristic8(pdf_f: F8, pdf_g: F8) -> F8 {
-    let (f, g) = (pdf_f * pdf_f, pdf_g * pdf_g);
-    let sum = f + g;
-    let degenerate = sum.eq(F8::splat(0.0)).or(!f.is_finite());
-    let fallback = pdf_f.abs().eq(F8::splat(f32::INFINITY)).select(F8::splat(1.0), F8::splat(0.0));
-    degenerate.select(fallback, f / sum)
-}
-
-#[inline(always)]
-fn fresnel_dielectric(cos_i: F8, cos_t: F8, eta_i: F8, eta_t: F8) -> F8 {
-    let parallel = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
-    let perpendicular = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
-    0.5 * (parallel * parallel + perpendicular * perpendicular)
-}
-
-/// `Frame::from_z` in lanes: [x, y, z].
-#[inline(always)]
-fn from_z(z: V8) -> [V8; 3] {
-    let sign = F8::splat(1.0).copysign(z.z);
-    let a = -1.0 / (sign + z.z);
-    let b = z.x * z.y * a;
-    let x = V8 { x: 1.0 + sign * z.x * z.x * a, y: sign * b, z: -sign * z.x };
-    let y = V8 { x: b, y: sign + z.y * z.y * a, z: -z.y };
-    [x, y, z]
-}
-
-#[inline(always)]
-fn to_world(frame: [V8; 3], v: V8) -> V8 {
-    frame[0] * v.x + frame[1] * v.y + frame[2] * v.z
-}
-
-/// `sampling::sin_cos` in lanes.
-#[inline(always)]
-fn sin_cos(x: F8) -> (F8, F8) {
-    const PI_2_HI: f32 = 1.570_312_5;
-    const PI_2_MID: f32 = 4.837_513e-4;
-    const PI_2_LO: f32 = 7.549_79e-8;
-    let shifted = x * FRAC_2_PI + ROUND_BY_ADDING;
-    let quadrant = shifted - ROUND_BY_ADDING;
-    let r = ((x - quadrant * PI_2_HI) - quadrant * PI_2_MID) - quadrant * PI_2_LO;
-    let (sin, cos) = sin_cos_reduced(r);
-    // The quadrant k sits in the low bits of `shifted`: cos is negative
-    // where bit 1 of k + 1 is set, that is where k's two low bits differ
-    let swap = shifted.bits_set(1);
-    let sin_negative = shifted.bits_set(2);
-    let cos_negative = swap.xor(sin_negative);
-    let (s, c) = (swap.select(cos, sin), swap.select(sin, cos));
-    (sin_negative.select(-s, s), cos_negative.select(-c, c))
-}
-
-/// `sampling::sin_cos_reduced` in lanes.
-#[inline(always)]
-fn sin_cos_reduced(r: F8) -> (F8, F8) {
-    let r2 = r * r;
-    let sin = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));
-    let cos = 1.0 - 0.5 * r2 + r2 * r2 * (4.166_664_6e-2 + r2 * (-1.388_731_6e-3 + r2 * 2.443_315_7e-5));
-    (sin, cos)
-}
-
-/// `sampling::cosine_hemisphere` (through the concentric disc) in lanes.
-#[inline(always)]
-fn cosine_hemisphere(u: (F8, F8)) -> V8 {
-    let (ox, oy) = (2.0 * u.0 - 1.0, 2.0 * u.1 - 1.0);
-    let zero = F8::splat(0.0);
-    let centre = ox.eq(zero).and(oy.eq(zero));
-    let (ax, ay) = (ox.abs(), oy.abs());
-    let wide = ax.gt(ay);
-    let r = wide.select(ox, oy);
-    // oy / ox where wide, ox / oy elsewhere, as the smaller magnitude over
-    // the larger with the quotient's sign (bit for bit the same): a division
-    // of selected lanes was split into lane-by-lane branches
-    let ratio = (ax.min(ay) / ax.max(ay)).copysign(ox * oy);
-    let (sin, cos) = sin_cos_reduced(FRAC_PI_4 * ratio);
-    let dx = centre.select(zero, r * wide.select(cos, sin));
-    let dy = centre.select(zero, r * wide.select(sin, cos));
-    let z = (1.0 - (dx * dx + dy * dy)).max(zero).sqrt();
-    V8 { x: dx, y: dy, z }
-}
-
-/// `sampling::uniform_cone` in lanes.
-#[inline(always)]
-fn uniform_cone(u: (F8, F8), one_minus_cos_max: F8) -> V8 {
-    let one_minus_cos = u.0 * one_minus_cos_max;
-    let cos_theta = 1.0 - one_minus_cos;
-    let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(F8::splat(0.0)).sqrt();
-    let (sin, cos) = sin_cos(2.0 * PI * u.1);
-    V8 { x: sin_theta * cos, y: sin_theta * sin, z: cos_theta }
-}
-
-/// `light::solid_angle_pdf` in lanes.
-#[inline(always)]
-fn solid_angle_pdf(p: V8, point: V8, normal: V8, area: F8) -> F8 {
-    let to_light = point - p;
-    let distance2 = to_light.length_squared();
-    let cos_light = normal.dot(-to_light) / distance2.sqrt();
-    cos_light.gt(F8::splat(0.0)).select(distance2 / (cos_light * area), F8::splat(0.0))
-}
-
-/// `geometry::ray::spawn_offset_scale` in lanes.
-#[inline(always)]
-fn spawn_offset_scale(p: V8) -> F8 {
-    let m = p.abs().max_element().max(F8::splat(f32::MIN_POSITIVE));
-    let ulp = m.binade_ulp().max(F8::splat(f32::from_bits(1)));
-    ulp * 256.0
-}
-
-/// `geometry::offset_ray_origin` in lanes.
-#[inline(always)]
-fn offset_ray_origin(point: V8, error: F8, normal: V8, direction: V8) -> V8 {
-    let distance = error * normal.abs().element_sum() + spawn_offset_scale(point);
-    let offset = direction.dot(normal).lt(F8::splat(0.0)).select_v(-normal * distance, normal * distance);
-    point + offset
 }
 
 #[cfg(test)]

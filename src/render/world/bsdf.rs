@@ -6,6 +6,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::Vec3;
 
+use crate::geometry::real::{Real, V3};
 use crate::geometry::Frame;
 use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power_cosine, power_cosine_pdf};
@@ -30,7 +31,13 @@ pub struct BsdfSample {
 
 #[inline]
 pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
-    2.0 * w.dot(n) * n - w
+    reflect_of(w.into(), n.into()).into()
+}
+
+/// `reflect` for one direction or several.
+#[inline(always)]
+pub fn reflect_of<R: Real>(w: V3<R>, n: V3<R>) -> V3<R> {
+    n * (w.dot(n) * 2.0) - w
 }
 
 #[inline]
@@ -39,11 +46,11 @@ fn luminance(c: Rgb) -> f32 {
 }
 
 /// Unpolarised Fresnel reflectance of a dielectric interface.
-#[inline]
-pub fn fresnel_dielectric(cos_i: f32, cos_t: f32, eta_i: f32, eta_t: f32) -> f32 {
+#[inline(always)]
+pub fn fresnel_dielectric<R: Real>(cos_i: R, cos_t: R, eta_i: R, eta_t: R) -> R {
     let parallel = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
     let perpendicular = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
-    0.5 * (parallel * parallel + perpendicular * perpendicular)
+    (parallel * parallel + perpendicular * perpendicular) * 0.5
 }
 
 /// Refraction of `wo` through a surface with normal `n` on `wo`'s side:
@@ -51,15 +58,36 @@ pub fn fresnel_dielectric(cos_i: f32, cos_t: f32, eta_i: f32, eta_t: f32) -> f32
 /// reflection, η_i/η_t).
 #[inline]
 pub fn refract(wo: Vec3, n: Vec3, eta_i: f32, eta_t: f32) -> (f32, Option<Vec3>, f32) {
+    let refraction = refraction_of(wo.into(), n.into(), eta_i, eta_t);
+    let direction = (!refraction.total).then(|| refraction.direction.into());
+    (refraction.fresnel, direction, refraction.eta)
+}
+
+/// What a dielectric does to `wo`, for one direction or several.
+#[derive(Clone, Copy, Debug)]
+pub struct Refraction<R: Real> {
+    /// Fresnel reflectance (1 under total internal reflection).
+    pub fresnel: R,
+    /// The refracted direction (meaningless where `total`).
+    pub direction: V3<R>,
+    /// η_i/η_t.
+    pub eta: R,
+    /// Total internal reflection.
+    pub total: R::Mask,
+}
+
+/// `refract` for one direction or several.
+#[inline(always)]
+pub fn refraction_of<R: Real>(wo: V3<R>, n: V3<R>, eta_i: R, eta_t: R) -> Refraction<R> {
     let eta = eta_i / eta_t;
-    let cos_i = wo.dot(n).clamp(0.0, 1.0);
-    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-    if sin2_t >= 1.0 {
-        return (1.0, None, eta);
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let fresnel = fresnel_dielectric(cos_i, cos_t, eta_i, eta_t);
-    (fresnel, Some((-eta * wo + (eta * cos_i - cos_t) * n).normalize()), eta)
+    // clamp(0, 1), a NaN kept
+    let cos_i = R::splat(1.0).min(R::splat(0.0).max(wo.dot(n)));
+    let sin2_t = eta * eta * (R::splat(1.0) - cos_i * cos_i);
+    let total = sin2_t.ge(R::splat(1.0));
+    let cos_t = (R::splat(1.0) - sin2_t).sqrt();
+    let fresnel = R::select(total, R::splat(1.0), fresnel_dielectric(cos_i, cos_t, eta_i, eta_t));
+    let direction = (wo * -eta + n * (eta * cos_i - cos_t)).normalize();
+    Refraction { fresnel, direction, eta, total }
 }
 
 /// Exact normalisation of the Blinn–Phong lobe at normal incidence

@@ -2,8 +2,8 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::geometry::real::{Real, V3};
 use crate::geometry::Ray;
-use crate::render::world::lanes::{F8, V8};
 use crate::render::world::rng::{PassStreams, Sampler};
 use crate::render::world::sampling::concentric_disk;
 use crate::scene::Camera;
@@ -62,19 +62,16 @@ impl CameraModel {
     /// lens sample `lens` in [0,1)².
     #[inline]
     pub fn generate_ray(&self, film: Vec2, lens: Vec2) -> Ray {
-        // Pixels to the image plane: multiplications by a pixel's extent
-        let sx = film.x * self.pixel_size.x - self.half_width;
-        let sy = self.half_height - film.y * self.pixel_size.y;
-        // Unit depth along the view axis, so scaling by a depth lands on that plane
-        let through = self.forward + self.right * sx + self.up * sy;
         if self.aperture_radius > 0.0 {
+            let through = Vec3::from(self.through_of(film.x, film.y));
             let l = concentric_disk(lens) * self.aperture_radius;
             let on_lens = self.position + self.right * l.x + self.up * l.y;
             let in_focus = self.position + through * self.focus_distance;
             let direction = (in_focus - on_lens).normalize();
             Ray::new(on_lens + direction * (self.near_clip / direction.dot(self.forward)), direction)
         } else {
-            Ray::new(self.position + through * self.near_clip, through.normalize())
+            let (origin, direction) = self.pinhole_rays_of(film.x, film.y);
+            Ray::new(origin.into(), direction.into())
         }
     }
 
@@ -95,13 +92,22 @@ impl CameraModel {
         y as u64 * self.columns as u64 + x as u64
     }
 
-    /// `generate_ray` of a pinhole for eight film positions: (origins, directions).
+    /// From the eye through film positions (pixels, y down), one or
+    /// several: the film maps to the image plane by multiplications by a
+    /// pixel's extent, at unit depth along the view axis, so scaling by a
+    /// depth lands on that plane.
     #[inline(always)]
-    pub(crate) fn pinhole_rays(&self, film_x: F8, film_y: F8) -> (V8, V8) {
+    fn through_of<R: Real>(&self, film_x: R, film_y: R) -> V3<R> {
         let sx = film_x * self.pixel_size.x - self.half_width;
-        let sy = self.half_height - film_y * self.pixel_size.y;
-        let through = V8::splat(self.forward) + V8::splat(self.right) * sx + V8::splat(self.up) * sy;
-        (V8::splat(self.position) + through * F8::splat(self.near_clip), through.normalize())
+        let sy = R::splat(self.half_height) - film_y * self.pixel_size.y;
+        V3::splat(self.forward) + V3::splat(self.right) * sx + V3::splat(self.up) * sy
+    }
+
+    /// A pinhole's rays through film positions: (origins, directions).
+    #[inline(always)]
+    pub(crate) fn pinhole_rays_of<R: Real>(&self, film_x: R, film_y: R) -> (V3<R>, V3<R>) {
+        let through = self.through_of(film_x, film_y);
+        (V3::splat(self.position) + through * R::splat(self.near_clip), through.normalize())
     }
 
     /// Whether rays start across a lens (and so need a lens sample).

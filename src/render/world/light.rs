@@ -5,6 +5,7 @@
 use glam::{Vec2, Vec3};
 
 use super::sampling::{uniform_cone, uniform_cone_pdf, uniform_triangle};
+use crate::geometry::real::{Real, V3};
 use crate::geometry::{Frame, Ray, SurfaceHit, Triangle};
 use crate::scene::{Attenuation, Rgb};
 
@@ -269,14 +270,16 @@ fn sample_area(emitter: &Emitter, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32, 
 /// 0 when the light's front faces away.
 #[inline]
 fn solid_angle_pdf(p: Vec3, point: Vec3, normal: Vec3, area: f32) -> f32 {
+    solid_angle_pdf_of(p.into(), point.into(), normal.into(), area)
+}
+
+/// `solid_angle_pdf` for one point or several.
+#[inline(always)]
+pub fn solid_angle_pdf_of<R: Real>(p: V3<R>, point: V3<R>, normal: V3<R>, area: R) -> R {
     let to_light = point - p;
     let distance2 = to_light.length_squared();
     let cos_light = normal.dot(-to_light) / distance2.sqrt();
-    if cos_light > 0.0 {
-        distance2 / (cos_light * area)
-    } else {
-        0.0
-    }
+    R::select(cos_light.gt(R::splat(0.0)), distance2 / (cos_light * area), R::splat(0.0))
 }
 
 impl LightSource {

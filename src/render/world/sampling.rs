@@ -4,6 +4,8 @@ use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
+use crate::geometry::real::{Mask, Real, V3};
+
 /// 1.5·2²³: a float this size has unit spacing, so adding it rounds to an integer.
 pub(crate) const ROUND_BY_ADDING: f32 = 12_582_912.0;
 
@@ -14,60 +16,83 @@ pub(crate) const ROUND_BY_ADDING: f32 = 12_582_912.0;
 /// 2·10⁻⁷ of the true values.
 #[inline]
 pub fn sin_cos(x: f32) -> (f32, f32) {
+    sin_cos_of(x)
+}
+
+/// `sin_cos` for one number or several.
+#[inline(always)]
+pub fn sin_cos_of<R: Real>(x: R) -> (R, R) {
     const PI_2_HI: f32 = 1.570_312_5;
     const PI_2_MID: f32 = 4.837_513e-4;
     const PI_2_LO: f32 = 7.549_79e-8;
     // Round to nearest by adding 1.5·2²³: the sum's last mantissa bits are
-    // the quadrant (mod 4, negatives included). No float-to-int conversion:
-    // `f32::round` is a libm call without SSE4.1, and the saturating `as i32`
-    // does not vectorise for `path_lanes`. Good for |x| < 2²¹.
+    // the quadrant k (mod 4, negatives included). No float-to-int
+    // conversion: `f32::round` is a libm call without SSE4.1, and the
+    // saturating `as i32` does not vectorise. Good for |x| < 2²¹.
     let shifted = x * FRAC_2_PI + ROUND_BY_ADDING;
     let quadrant = shifted - ROUND_BY_ADDING;
-    let k = shifted.to_bits();
     let r = ((x - quadrant * PI_2_HI) - quadrant * PI_2_MID) - quadrant * PI_2_LO;
     let (sin, cos) = sin_cos_reduced(r);
-    match k & 3 {
-        0 => (sin, cos),
-        1 => (cos, -sin),
-        2 => (-sin, -cos),
-        _ => (-cos, sin),
-    }
+    // k odd swaps sine and cosine; sine is negative where bit 1 of k is
+    // set, cosine where k's two low bits differ
+    let swap = shifted.bits_set(1);
+    let sin_negative = shifted.bits_set(2);
+    let cos_negative = swap.xor(sin_negative);
+    let (s, c) = (R::select(swap, cos, sin), R::select(swap, sin, cos));
+    (R::select(sin_negative, -s, s), R::select(cos_negative, -c, c))
 }
 
 /// `sin_cos` for |r| ≤ π/4: cephes' minimax polynomials alone.
 #[inline(always)]
-pub(crate) fn sin_cos_reduced(r: f32) -> (f32, f32) {
+pub fn sin_cos_reduced<R: Real>(r: R) -> (R, R) {
     let r2 = r * r;
-    let sin = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));
-    let cos = 1.0 - 0.5 * r2 + r2 * r2 * (4.166_664_6e-2 + r2 * (-1.388_731_6e-3 + r2 * 2.443_315_7e-5));
+    // The coefficients' additions written as the scalar code had them:
+    // a + b and b + a round alike, a − b and −b + a too
+    let one = R::splat(1.0);
+    let sin = r + r * r2 * (r2 * (r2 * -1.951_529_6e-4 + 8.332_161e-3) + -1.666_665_5e-1);
+    let cos = (one - r2 * 0.5) + r2 * r2 * (r2 * (r2 * 2.443_315_7e-5 + -1.388_731_6e-3) + 4.166_664_6e-2);
     (sin, cos)
 }
 
 /// Shirley–Chiu concentric map: low distortion, so stratification survives.
 #[inline]
 pub fn concentric_disk(u: Vec2) -> Vec2 {
-    let o = 2.0 * u - Vec2::ONE;
-    if o == Vec2::ZERO {
-        return Vec2::ZERO;
-    }
-    // The angle is φ = π/4 · ratio in the wide wedges and π/2 − φ in the
-    // tall ones, whose sine and cosine are φ's swapped: no range reduction
-    let wide = o.x.abs() > o.y.abs();
-    let (r, ratio) = if wide { (o.x, o.y / o.x) } else { (o.y, o.x / o.y) };
-    let (sin, cos) = sin_cos_reduced(FRAC_PI_4 * ratio);
-    if wide {
-        r * Vec2::new(cos, sin)
-    } else {
-        r * Vec2::new(sin, cos)
-    }
+    let (x, y) = concentric_disk_of(u.x, u.y);
+    Vec2::new(x, y)
+}
+
+/// `concentric_disk` for one point or several. The angle is φ = π/4 · ratio
+/// in the wide wedges and π/2 − φ in the tall ones, whose sine and cosine
+/// are φ's swapped: no range reduction. The ratio is the smaller magnitude
+/// over the larger with the quotient's sign (bit for bit oy/ox or ox/oy): a
+/// division of selected lanes would split into lane-by-lane branches.
+#[inline(always)]
+pub fn concentric_disk_of<R: Real>(u0: R, u1: R) -> (R, R) {
+    let (ox, oy) = (u0 * 2.0 - 1.0, u1 * 2.0 - 1.0);
+    let zero = R::splat(0.0);
+    let centre = ox.eq(zero).and(oy.eq(zero));
+    let (ax, ay) = (ox.abs(), oy.abs());
+    let wide = ax.gt(ay);
+    let r = R::select(wide, ox, oy);
+    let ratio = (ax.min(ay) / ax.max(ay)).copysign(ox * oy);
+    let (sin, cos) = sin_cos_reduced(ratio * FRAC_PI_4);
+    let dx = R::select(centre, zero, r * R::select(wide, cos, sin));
+    let dy = R::select(centre, zero, r * R::select(wide, sin, cos));
+    (dx, dy)
 }
 
 /// Cosine-weighted direction about +z; pdf = cos θ / π.
 #[inline]
 pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = concentric_disk(u);
-    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
-    Vec3::new(d.x, d.y, z)
+    cosine_hemisphere_of(u.x, u.y).into()
+}
+
+/// `cosine_hemisphere` for one sample or several.
+#[inline(always)]
+pub fn cosine_hemisphere_of<R: Real>(u0: R, u1: R) -> V3<R> {
+    let (dx, dy) = concentric_disk_of(u0, u1);
+    let z = (R::splat(1.0) - (dx * dx + dy * dy)).max(R::splat(0.0)).sqrt();
+    V3::new(dx, dy, z)
 }
 
 #[inline]
@@ -89,11 +114,17 @@ pub fn uniform_sphere(u: Vec2) -> Vec3 {
 /// pdf = 1 / (2π(1 − cos θmax)).
 #[inline]
 pub fn uniform_cone(u: Vec2, one_minus_cos_max: f32) -> Vec3 {
-    let one_minus_cos = u.x * one_minus_cos_max;
-    let cos_theta = 1.0 - one_minus_cos;
-    let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
-    let (sin, cos) = sin_cos(2.0 * PI * u.y);
-    Vec3::new(sin_theta * cos, sin_theta * sin, cos_theta)
+    uniform_cone_of(u.x, u.y, one_minus_cos_max).into()
+}
+
+/// `uniform_cone` for one sample or several.
+#[inline(always)]
+pub fn uniform_cone_of<R: Real>(u0: R, u1: R, one_minus_cos_max: R) -> V3<R> {
+    let one_minus_cos = u0 * one_minus_cos_max;
+    let cos_theta = R::splat(1.0) - one_minus_cos;
+    let sin_theta = (one_minus_cos * (R::splat(2.0) - one_minus_cos)).max(R::splat(0.0)).sqrt();
+    let (sin, cos) = sin_cos_of(u1 * (2.0 * PI));
+    V3::new(sin_theta * cos, sin_theta * sin, cos_theta)
 }
 
 #[inline]
@@ -126,14 +157,20 @@ pub fn uniform_triangle(u: Vec2) -> (f32, f32) {
     (1.0 - su, u.y * su)
 }
 
-/// Veach's power heuristic with β = 2.
+/// Veach's power heuristic with β = 2; an infinite `pdf_f` (a delta
+/// light) weighs 1, a degenerate pair 0.
 #[inline]
 pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
+    power_heuristic_of(pdf_f, pdf_g)
+}
+
+/// `power_heuristic` for one pair or several.
+#[inline(always)]
+pub fn power_heuristic_of<R: Real>(pdf_f: R, pdf_g: R) -> R {
     let (f, g) = (pdf_f * pdf_f, pdf_g * pdf_g);
-    if f + g == 0.0 || !f.is_finite() {
-        return if pdf_f.is_infinite() { 1.0 } else { 0.0 };
-    }
-    f / (f + g)
+    let sum = f + g;
+    let fallback = R::select(pdf_f.abs().eq(R::splat(f32::INFINITY)), R::splat(1.0), R::splat(0.0));
+    R::select(sum.ne(R::splat(0.0)).and(f.is_finite()), f / sum, fallback)
 }
 
 #[cfg(test)]

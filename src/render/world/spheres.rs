@@ -4,6 +4,8 @@
 
 use glam::{BVec4A, Vec3, Vec4};
 
+use crate::geometry::real::V3;
+use crate::geometry::sphere::nearest_root;
 use crate::geometry::Ray;
 
 /// Lanes with no sphere: a centre at infinity gives NaN, and every
@@ -49,25 +51,9 @@ impl SphereLanes {
     #[inline(always)]
     fn group(cx: Vec4, cy: Vec4, cz: Vec4, r2: Vec4, ray: &Ray, t_max: Vec4) -> (Vec4, BVec4A) {
         let (o, d) = (ray.origin, ray.direction);
-        let fx = Vec4::splat(o.x) - cx;
-        let fy = Vec4::splat(o.y) - cy;
-        let fz = Vec4::splat(o.z) - cz;
-        let (dx, dy, dz) = (Vec4::splat(d.x), Vec4::splat(d.y), Vec4::splat(d.z));
-        let b = fx * dx + fy * dy + fz * dz;
-        // Discriminant from the closest approach (Ray Tracing Gems ch. 7)
-        let lx = fx - b * dx;
-        let ly = fy - b * dy;
-        let lz = fz - b * dz;
-        let discriminant = r2 - (lx * lx + ly * ly + lz * lz);
-        let c = fx * fx + fy * fy + fz * fz - r2;
-        let q = -b - discriminant.max(Vec4::ZERO).sqrt().copysign(b);
-        let (t0, t1) = (c / q, q);
-        let (near, far) = (t0.min(t1), t0.max(t1));
-        let hits = discriminant.cmpge(Vec4::ZERO);
-        let near_ok = hits & near.cmpgt(Vec4::ZERO) & near.cmplt(t_max);
-        let far_ok = hits & far.cmpgt(Vec4::ZERO) & far.cmplt(t_max);
-        let t = Vec4::select(near_ok, near, Vec4::select(far_ok, far, Vec4::INFINITY));
-        (t, near_ok)
+        let f = V3::new(Vec4::splat(o.x) - cx, Vec4::splat(o.y) - cy, Vec4::splat(o.z) - cz);
+        let (t, hit, near) = nearest_root(f, V3::splat(d), r2, t_max);
+        (Vec4::select(hit, t, Vec4::INFINITY), hit & near)
     }
 
     /// The groups' lanes side by side (zipped: no bounds checks in the loop).

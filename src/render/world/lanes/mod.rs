@@ -9,10 +9,11 @@
 //! exist only where AVX2 does (`supported`). Elsewhere they are arrays
 //! (`portable`), which the tests also hold the intrinsics to.
 
-use std::ops::{Add, Div, Mul, Neg, Sub};
+use std::ops::{Add, Div, Mul, Sub};
 
 use glam::Vec3;
 
+use crate::geometry::real::{Mask, Real, V3};
 use crate::render::world::rng::{mix64, unit_from_24_bits, Sampler};
 
 pub const LANES: usize = 8;
@@ -118,23 +119,101 @@ impl M8 {
 }
 
 /// Eight 3-vectors (points, directions or colours), as glam computes them.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct V8 {
-    pub x: F8,
-    pub y: F8,
-    pub z: F8,
+pub type V8 = V3<F8>;
+
+/// What the lanes share with the scalar code: the math of `geometry::real`.
+impl Mask for M8 {
+    #[inline(always)]
+    fn and(self, other: M8) -> M8 {
+        M8::and(self, other)
+    }
+    #[inline(always)]
+    fn or(self, other: M8) -> M8 {
+        M8::or(self, other)
+    }
+    #[inline(always)]
+    fn and_not(self, other: M8) -> M8 {
+        M8::and_not(self, other)
+    }
+    #[inline(always)]
+    fn xor(self, other: M8) -> M8 {
+        M8::xor(self, other)
+    }
 }
 
-impl V8 {
+impl Real for F8 {
+    type Mask = M8;
     #[inline(always)]
-    pub fn splat(v: Vec3) -> Self {
-        V8 { x: F8::splat(v.x), y: F8::splat(v.y), z: F8::splat(v.z) }
+    fn splat(v: f32) -> F8 {
+        F8::splat(v)
     }
+    #[inline(always)]
+    fn sqrt(self) -> F8 {
+        F8::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> F8 {
+        F8::abs(self)
+    }
+    #[inline(always)]
+    fn min(self, other: F8) -> F8 {
+        F8::min(self, other)
+    }
+    #[inline(always)]
+    fn max(self, other: F8) -> F8 {
+        F8::max(self, other)
+    }
+    #[inline(always)]
+    fn copysign(self, sign: F8) -> F8 {
+        F8::copysign(self, sign)
+    }
+    #[inline(always)]
+    fn lt(self, other: F8) -> M8 {
+        F8::lt(self, other)
+    }
+    #[inline(always)]
+    fn le(self, other: F8) -> M8 {
+        F8::le(self, other)
+    }
+    #[inline(always)]
+    fn gt(self, other: F8) -> M8 {
+        F8::gt(self, other)
+    }
+    #[inline(always)]
+    fn ge(self, other: F8) -> M8 {
+        F8::ge(self, other)
+    }
+    #[inline(always)]
+    fn eq(self, other: F8) -> M8 {
+        F8::eq(self, other)
+    }
+    #[inline(always)]
+    fn ne(self, other: F8) -> M8 {
+        F8::ne(self, other)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> M8 {
+        F8::is_finite(self)
+    }
+    #[inline(always)]
+    fn select(mask: M8, a: F8, b: F8) -> F8 {
+        mask.select(a, b)
+    }
+    #[inline(always)]
+    fn binade_ulp(self) -> F8 {
+        F8::binade_ulp(self)
+    }
+    #[inline(always)]
+    fn bits_set(self, bits: u32) -> M8 {
+        F8::bits_set(self, bits)
+    }
+}
 
+impl V3<F8> {
     #[inline(always)]
     pub fn from_fn(f: impl Fn(usize) -> Vec3) -> Self {
         let v: [Vec3; LANES] = each(f);
-        V8 { x: F8::from_fn(|i| v[i].x), y: F8::from_fn(|i| v[i].y), z: F8::from_fn(|i| v[i].z) }
+        V3 { x: F8::from_fn(|i| v[i].x), y: F8::from_fn(|i| v[i].y), z: F8::from_fn(|i| v[i].z) }
     }
 
     #[inline(always)]
@@ -149,96 +228,11 @@ impl V8 {
         self.z.set_lane(i, v.z);
     }
 
-    #[inline(always)]
-    pub fn dot(self, o: V8) -> F8 {
-        self.x * o.x + self.y * o.y + self.z * o.z
-    }
-
-    #[inline(always)]
-    pub fn length_squared(self) -> F8 {
-        self.dot(self)
-    }
-
-    #[inline(always)]
-    pub fn length(self) -> F8 {
-        self.dot(self).sqrt()
-    }
-
-    /// glam's `normalize`: times the reciprocal of the length.
-    #[inline(always)]
-    pub fn normalize(self) -> V8 {
-        self * (1.0 / self.length())
-    }
-
-    #[inline(always)]
-    pub fn abs(self) -> V8 {
-        V8 { x: self.x.abs(), y: self.y.abs(), z: self.z.abs() }
-    }
-
-    #[inline(always)]
-    pub fn max_element(self) -> F8 {
-        self.x.max(self.y).max(self.z)
-    }
-
-    #[inline(always)]
-    pub fn element_sum(self) -> F8 {
-        self.x + self.y + self.z
-    }
-
     /// Any component differs from zero (`v != Vec3::ZERO`).
     #[inline(always)]
     pub fn nonzero(self) -> M8 {
         let zero = F8::splat(0.0);
         self.x.ne(zero).or(self.y.ne(zero)).or(self.z.ne(zero))
-    }
-}
-
-impl Add for V8 {
-    type Output = V8;
-    #[inline(always)]
-    fn add(self, o: V8) -> V8 {
-        V8 { x: self.x + o.x, y: self.y + o.y, z: self.z + o.z }
-    }
-}
-
-impl Sub for V8 {
-    type Output = V8;
-    #[inline(always)]
-    fn sub(self, o: V8) -> V8 {
-        V8 { x: self.x - o.x, y: self.y - o.y, z: self.z - o.z }
-    }
-}
-
-/// Component by component (colours).
-impl Mul for V8 {
-    type Output = V8;
-    #[inline(always)]
-    fn mul(self, o: V8) -> V8 {
-        V8 { x: self.x * o.x, y: self.y * o.y, z: self.z * o.z }
-    }
-}
-
-impl Mul<F8> for V8 {
-    type Output = V8;
-    #[inline(always)]
-    fn mul(self, s: F8) -> V8 {
-        V8 { x: self.x * s, y: self.y * s, z: self.z * s }
-    }
-}
-
-impl Div<F8> for V8 {
-    type Output = V8;
-    #[inline(always)]
-    fn div(self, s: F8) -> V8 {
-        V8 { x: self.x / s, y: self.y / s, z: self.z / s }
-    }
-}
-
-impl Neg for V8 {
-    type Output = V8;
-    #[inline(always)]
-    fn neg(self) -> V8 {
-        V8 { x: -self.x, y: -self.y, z: -self.z }
     }
 }
 
