@@ -1,6 +1,12 @@
-//! Small scenes built in code for closed-form tests.
+//! What the tests share: small scenes built in code, and renders checked
+//! for non-finite pixels.
 #![allow(dead_code)]
 
+use std::sync::Arc;
+
+use gi_studio::render::world::rng::Sampler;
+use gi_studio::render::world::sampling::uniform_sphere;
+use gi_studio::render::{render_blocking, Algorithm, LinearImage, RenderJob, RenderSettings};
 use gi_studio::scene::*;
 use glam::Vec3;
 
@@ -61,4 +67,21 @@ pub fn valid(scene: impl Into<Scene>) -> ValidScene {
 
 pub fn mean_luminance(pixels: &[[f32; 3]]) -> f64 {
     pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / pixels.len() as f64
+}
+
+pub fn random_direction(s: &mut Sampler) -> Vec3 {
+    uniform_sphere(s.next_2d())
+}
+
+/// Settings for a test render: `spp` passes, a fixed seed.
+pub fn settings(algorithm: Algorithm, width: u32, height: u32, spp: u32) -> RenderSettings {
+    RenderSettings { width, height, samples_per_pixel: Some(spp), seed: 9, ..RenderSettings::for_algorithm(algorithm) }
+}
+
+/// Render, and insist no NaN or infinity reached the film; the count of
+/// dropped non-finite samples.
+pub fn render(scene: &Scene, settings: RenderSettings) -> (LinearImage, u64) {
+    let (image, stats) = render_blocking(&RenderJob::new(Arc::new(valid(scene.clone())), settings)).expect("renders");
+    assert!(image.pixels.iter().flatten().all(|c| c.is_finite()), "a non-finite pixel reached the film");
+    (image, stats.non_finite)
 }

@@ -1,0 +1,128 @@
+//! Light transport on hard cases: glass in a furnace, an analytic furnace,
+//! degenerate inputs, fireflies.
+
+mod common;
+
+use std::f32::consts::PI;
+
+use common::*;
+use gi_studio::render::world::bsdf::{Bsdf, Transport};
+use gi_studio::render::world::rng::Sampler;
+use gi_studio::render::world::sampling::{cosine_hemisphere, power_cosine, uniform_cone, uniform_sphere};
+use gi_studio::render::{Algorithm, RenderSettings};
+use gi_studio::scene::{LightKind, MaterialModel, Problem, Shape};
+use glam::{Vec2, Vec3};
+
+/// Glass: a lossless ball in a white furnace reflects and transmits
+/// everything (radiance 1); from inside the ball radiance is n² = 2.25;
+/// total internal reflection at grazing angles.
+#[test]
+fn glass_conserves_energy_and_reflects_totally() {
+    let mut furnace = scene(
+        camera(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO),
+        vec![material("glass", MaterialModel::Glass { ior: 1.5, tint: Vec3::ONE })],
+        vec![object("ball", Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, "glass")],
+        vec![],
+    );
+    furnace.background = Vec3::ONE;
+    let outside = mean_luminance(&render(&furnace, settings(Algorithm::Path, 24, 18, 64)).0.pixels);
+    assert!((outside - 1.0).abs() < 0.01, "outside: {outside}");
+    furnace.camera = camera(Vec3::new(0.0, 0.0, 0.2), Vec3::new(0.0, 0.0, -1.0));
+    let (image, non_finite) = render(&furnace, settings(Algorithm::Path, 24, 18, 256));
+    assert_eq!(non_finite, 0);
+    let inside = mean_luminance(&image.pixels);
+    assert!((inside - 2.25).abs() < 0.05, "inside: {inside}");
+    // Leaving glass at 80° from the normal: everything reflects
+    let wo = Vec3::new(80f32.to_radians().sin(), 0.0, 80f32.to_radians().cos());
+    let mut s = Sampler::new(12, 0, 12);
+    for _ in 0..100 {
+        let b = Bsdf::Glass { ior: 1.5, tint: Vec3::ONE }.sample(wo, -Vec3::Z, &mut s, Transport::Radiance).unwrap();
+        assert!(b.wi.z > 0.0 && (b.wi - Vec3::new(-wo.x, 0.0, wo.z)).length() < 1e-5);
+    }
+}
+
+/// Inside a unit sphere of albedo ½ with a point light of intensity π at
+/// its centre, full global illumination converges to radiance 1 — for the
+/// path tracer and for progressive photon mapping; Whitted gives the direct ½.
+#[test]
+fn an_analytic_furnace_converges_to_one() {
+    let mut inside = scene(
+        camera(Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.0, 0.0, -1.0)),
+        vec![material("inside", lambert(0.5))],
+        vec![object("shell", Shape::Sphere { center: Vec3::ZERO, radius: 1.0 }, "inside")],
+        vec![light("centre", LightKind::Point { position: Vec3::ZERO }, PI)],
+    );
+    inside.camera.fov_y_degrees = 60.0;
+    let path = mean_luminance(&render(&inside, settings(Algorithm::Path, 16, 12, 256)).0.pixels);
+    assert!((path - 1.0).abs() < 0.025, "path: {path}");
+    let mut sppm = settings(Algorithm::Sppm, 16, 12, 64);
+    sppm.set_photons(20_000);
+    let progressive = mean_luminance(&render(&inside, sppm).0.pixels);
+    assert!((progressive - 1.0).abs() < 0.025, "sppm: {progressive}");
+    let direct = mean_luminance(&render(&inside, settings(Algorithm::Whitted, 16, 12, 1)).0.pixels);
+    assert!((direct - 0.5).abs() < 1e-3, "whitted: {direct}");
+}
+
+/// Samples with u → 1, zero-length normals and a = b = c = 0 refused,
+/// spot exponents 0 and 10⁴, a light exactly on a surface.
+#[test]
+fn degenerate_inputs_are_refused_or_harmless() {
+    let u = Vec2::splat(1.0 - f32::EPSILON / 2.0);
+    for d in [cosine_hemisphere(u), uniform_sphere(u), uniform_cone(u, 0.3), power_cosine(u, 1e4)] {
+        assert!(d.is_finite() && (d.length() - 1.0).abs() < 1e-4, "{d}");
+    }
+    let mut scene = floor_scene(0.5, vec![]);
+    scene.objects[0].shape = Shape::Plane { point: Vec3::ZERO, normal: Vec3::ZERO };
+    assert!(scene.validate().iter().any(|p| p.problem == Problem::ZeroLength));
+    let mut scene = floor_scene(0.5, vec![light("bulb", LightKind::Point { position: Vec3::Y }, 1.0)]);
+    scene.lights[0].attenuation = gi_studio::scene::Attenuation { a: 0.0, b: 0.0, c: 0.0 };
+    assert!(scene.validate().iter().any(|p| p.problem == Problem::ZeroAttenuation));
+    for exponent in [0.0, 1.0e4] {
+        let spot = LightKind::Spot {
+            position: Vec3::new(0.0, 2.0, 0.0),
+            direction: -Vec3::Y,
+            cone_angle_degrees: 30.0,
+            falloff_exponent: exponent,
+        };
+        let (image, non_finite) =
+            render(&floor_scene(0.5, vec![light("spot", spot, 5.0)]), settings(Algorithm::Path, 16, 12, 4));
+        assert_eq!(non_finite, 0);
+        assert!(image.mean()[0] > 0.0);
+    }
+    // A point light lying on the floor: the film stays finite
+    let on_surface = floor_scene(0.5, vec![light("bulb", LightKind::Point { position: Vec3::ZERO }, 5.0)]);
+    for algorithm in Algorithm::ALL {
+        let mut s = settings(algorithm, 16, 12, 2);
+        s.set_photons(2_000);
+        render(&on_surface, s);
+    }
+}
+
+/// Fireflies: a tiny bright light behind glass. The film stays finite;
+/// clamping is off by default and, when asked for, visibly bounds pixels.
+#[test]
+fn fireflies_stay_finite_and_clamping_bounds_them() {
+    let mut scene = scene(
+        camera(Vec3::new(0.0, 1.0, 4.0), Vec3::new(0.0, 0.5, 0.0)),
+        vec![
+            material("floor", lambert(0.8)),
+            material("glass", MaterialModel::Glass { ior: 1.5, tint: Vec3::ONE }),
+            material("spark", MaterialModel::Emissive { radiance: Vec3::splat(1.0e5) }),
+        ],
+        vec![
+            object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor"),
+            object("lens", Shape::Sphere { center: Vec3::new(0.0, 0.6, 0.0), radius: 0.5 }, "glass"),
+            object("spark", Shape::Sphere { center: Vec3::new(0.0, 0.6, -0.9), radius: 0.005 }, "spark"),
+        ],
+        vec![],
+    );
+    scene.background = Vec3::splat(0.01);
+    assert_eq!(RenderSettings::default().firefly_clamp, 0.0);
+    let (free, non_finite) = render(&scene, settings(Algorithm::Path, 24, 18, 16));
+    assert_eq!(non_finite, 0);
+    let mut clamped = settings(Algorithm::Path, 24, 18, 16);
+    clamped.firefly_clamp = 1.0;
+    let (bounded, _) = render(&scene, clamped);
+    assert!(bounded.pixels.iter().flatten().all(|c| *c <= 1.0));
+    assert!(free.pixels.iter().flatten().cloned().fold(0.0, f32::max) > 1.0, "the unclamped film keeps its fireflies");
+}
