@@ -33,6 +33,7 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("caustics", "whitted", 0xb91b2d20a3a39a19),
     ("caustics", "path", 0x254a1bdcdc40f3eb),
     ("caustics", "photon", 0x4cd0fde0f1043e21),
+    ("cornell", "photon+final-gather", 0x98e90179c8680538),
     ("caustics", "sppm", 0x61a9d04d5163d909),
 ];
 
@@ -41,7 +42,11 @@ pub fn image_hash(image: &LinearImage) -> u64 {
     words.flat_map(u32::to_le_bytes).fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
 }
 
-fn golden_render(preset: &str, algorithm: Algorithm) -> LinearImage {
+fn golden_render(preset: &str, name: &str) -> LinearImage {
+    let (algorithm, final_gather) = match name.split_once('+') {
+        Some((algorithm, _)) => (algorithm.parse().unwrap(), true),
+        None => (name.parse().unwrap(), false),
+    };
     let scene = presets::preset(preset).unwrap().unwrap();
     let mut settings = RenderSettings {
         width: 64,
@@ -51,6 +56,9 @@ fn golden_render(preset: &str, algorithm: Algorithm) -> LinearImage {
         ..RenderSettings::for_algorithm(algorithm)
     };
     settings.set_photons(20_000);
+    if let Some(p) = settings.photon_mut() {
+        (p.final_gather, p.final_gather_rays) = (final_gather, 4);
+    }
     render_blocking(&RenderJob::new(Arc::new(valid(scene)), settings)).unwrap().0
 }
 
@@ -58,7 +66,7 @@ fn golden_render(preset: &str, algorithm: Algorithm) -> LinearImage {
 fn every_preset_and_algorithm_renders_its_golden_image() {
     let mut changed = Vec::new();
     for &(preset, algorithm, expected) in GOLDEN {
-        let found = image_hash(&golden_render(preset, algorithm.parse().unwrap()));
+        let found = image_hash(&golden_render(preset, algorithm));
         if found != expected {
             changed.push(format!("    (\"{preset}\", \"{algorithm}\", {found:#018x}),"));
         }

@@ -9,6 +9,7 @@ pub mod path;
 pub mod path_lanes;
 pub mod photon;
 pub mod photon_map;
+pub mod specular;
 pub mod sppm;
 pub mod whitted;
 

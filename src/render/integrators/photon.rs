@@ -10,6 +10,7 @@ use glam::Vec3;
 use super::next_event::PathScope;
 use super::photon_map::kdtree::Neighbours;
 use super::photon_map::maps::{estimate, PhotonMaps, QueryStats};
+use super::specular::{follow_specular, Emission, Landing};
 use super::{Counters, Stage};
 use crate::geometry::Ray;
 use crate::render::settings::PhotonSettings;
@@ -101,33 +102,9 @@ impl PhotonRenderer<'_> {
         counters: &mut Counters,
         scratch: &mut PhotonScratch,
     ) -> Rgb {
-        let world = self.world;
-        let mut ray = *ray;
-        let mut throughput = Rgb::ONE;
-        let mut radiance = Rgb::ZERO;
-        for _ in 0..self.max_depth {
-            counters.rays += 1;
-            let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
-                radiance += throughput * world.background;
-                break;
-            };
-            let wo = -ray.direction;
-            // Only specular bounces lead here, so emission is not light-sampled
-            radiance += throughput * world.emitted(&hit, wo);
-            let bsdf = Bsdf::new(world.material_of(&hit));
-            if bsdf.is_specular() {
-                let Some(s) = bsdf.sample(wo, hit.surface.normal, sampler, Transport::Radiance) else {
-                    break;
-                };
-                throughput *= s.weight;
-                ray = hit.surface.spawn_ray(s.wi);
-                continue;
-            }
-            radiance +=
-                throughput * self.shade(&hit, wo, &bsdf, self.settings.final_gather, sampler, counters, scratch);
-            break;
-        }
-        radiance
+        let (radiance, landing) = follow_specular(self.world, ray, self.max_depth, Emission::Count, sampler, counters);
+        let Some(Landing { hit, wo, bsdf, throughput }) = landing else { return radiance };
+        radiance + throughput * self.shade(&hit, wo, &bsdf, self.settings.final_gather, sampler, counters, scratch)
     }
 
     /// Outgoing radiance at a non-specular hit, emission excluded.
@@ -142,7 +119,6 @@ impl PhotonRenderer<'_> {
         counters: &mut Counters,
         scratch: &mut PhotonScratch,
     ) -> Rgb {
-        let world = self.world;
         let n = hit.surface.normal;
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
         let mut radiance = self.radiance_from_maps(hit, wo, facing, bsdf, !gather, sampler, counters, scratch);
@@ -157,16 +133,7 @@ impl PhotonRenderer<'_> {
             }
             radiance += sum / rays as f32;
         } else {
-            // Photons come only from lights: the background reaches the
-            // surface through one BSDF-sampled ray
-            if world.background != Rgb::ZERO {
-                if let Some(s) = bsdf.sample(wo, n, sampler, Transport::Radiance) {
-                    counters.rays += 1;
-                    if world.intersect(&hit.surface.spawn_ray(s.wi), f32::INFINITY).is_none() {
-                        radiance += s.weight * world.background;
-                    }
-                }
-            }
+            radiance += self.scope.background(hit, wo, bsdf, Rgb::ONE, sampler, counters);
         }
         radiance
     }
@@ -174,34 +141,13 @@ impl PhotonRenderer<'_> {
     /// Radiance arriving along a final-gather ray: the maps' full estimate at
     /// the next non-specular surface. Emitters seen directly (or through
     /// mirrors) are skipped: direct light and caustics already count them.
-    fn gathered(
-        &self,
-        mut ray: Ray,
-        sampler: &mut Sampler,
-        counters: &mut Counters,
-        scratch: &mut PhotonScratch,
-    ) -> Rgb {
-        let world = self.world;
-        let mut throughput = Rgb::ONE;
-        for _ in 0..GATHER_SPECULAR_DEPTH {
-            counters.rays += 1;
-            let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
-                return throughput * world.background;
-            };
-            let wo = -ray.direction;
-            let bsdf = Bsdf::new(world.material_of(&hit));
-            if !bsdf.is_specular() {
-                let n = hit.surface.normal;
-                let facing = if wo.dot(n) < 0.0 { -n } else { n };
-                return throughput * self.radiance_from_maps(&hit, wo, facing, &bsdf, true, sampler, counters, scratch);
-            }
-            let Some(s) = bsdf.sample(wo, hit.surface.normal, sampler, Transport::Radiance) else {
-                return Rgb::ZERO;
-            };
-            throughput *= s.weight;
-            ray = hit.surface.spawn_ray(s.wi);
-        }
-        Rgb::ZERO
+    fn gathered(&self, ray: Ray, sampler: &mut Sampler, counters: &mut Counters, scratch: &mut PhotonScratch) -> Rgb {
+        let emission = Emission::Skip;
+        let (radiance, landing) = follow_specular(self.world, &ray, GATHER_SPECULAR_DEPTH, emission, sampler, counters);
+        let Some(Landing { hit, wo, bsdf, throughput }) = landing else { return radiance };
+        let n = hit.surface.normal;
+        let facing = if wo.dot(n) < 0.0 { -n } else { n };
+        throughput * self.radiance_from_maps(&hit, wo, facing, &bsdf, true, sampler, counters, scratch)
     }
 }
 

@@ -15,11 +15,12 @@ use rayon::prelude::*;
 use super::next_event::PathScope;
 use super::photon_map::kdtree::PhotonKdTree;
 use super::photon_map::trace::{trace_photons, MapKind};
+use super::specular::{follow_specular, Emission, Landing};
 use super::{Counters, PassObserver, PassReport, Stage};
 use crate::geometry::Ray;
 use crate::render::film::Film;
 use crate::render::settings::{RenderSettings, SppmSettings};
-use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::bsdf::Bsdf;
 use crate::render::world::camera::CameraTile;
 use crate::render::world::rng::Sampler;
 use crate::render::world::World;
@@ -209,40 +210,14 @@ pub fn camera_pass(
     counters: &mut Counters,
 ) -> (Rgb, Option<VisiblePoint>) {
     let scope = PathScope::new(world, ray.origin);
-    let mut ray = *ray;
-    let mut throughput = Rgb::ONE;
-    let mut radiance = Rgb::ZERO;
-    for _ in 0..max_depth {
-        counters.rays += 1;
-        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
-            return (radiance + throughput * world.background, None);
-        };
-        let wo = -ray.direction;
-        radiance += throughput * world.emitted(&hit, wo);
-        let bsdf = Bsdf::new(world.material_of(&hit));
-        let n = hit.surface.normal;
-        if bsdf.is_specular() {
-            let Some(s) = bsdf.sample(wo, n, sampler, Transport::Radiance) else {
-                break;
-            };
-            throughput *= s.weight;
-            ray = hit.surface.spawn_ray(s.wi);
-            continue;
-        }
-        let facing = if wo.dot(n) < 0.0 { -n } else { n };
-        radiance += throughput * scope.every_light(&hit, wo, facing, &bsdf, sampler, counters);
-        if world.background != Rgb::ZERO {
-            if let Some(s) = bsdf.sample(wo, n, sampler, Transport::Radiance) {
-                counters.rays += 1;
-                if world.intersect(&hit.surface.spawn_ray(s.wi), f32::INFINITY).is_none() {
-                    radiance += throughput * s.weight * world.background;
-                }
-            }
-        }
-        let visible = VisiblePoint { point: hit.surface.point, facing, wo, bsdf, throughput };
-        return (radiance, Some(visible));
-    }
-    (radiance, None)
+    let (mut radiance, landing) = follow_specular(world, ray, max_depth, Emission::Count, sampler, counters);
+    let Some(Landing { hit, wo, bsdf, throughput }) = landing else { return (radiance, None) };
+    let n = hit.surface.normal;
+    let facing = if wo.dot(n) < 0.0 { -n } else { n };
+    radiance += throughput * scope.every_light(&hit, wo, facing, &bsdf, sampler, counters);
+    radiance += scope.background(&hit, wo, &bsdf, throughput, sampler, counters);
+    let visible = VisiblePoint { point: hit.surface.point, facing, wo, bsdf, throughput };
+    (radiance, Some(visible))
 }
 
 #[cfg(test)]
