@@ -9,7 +9,7 @@ mod common;
 use common::valid;
 use std::sync::Arc;
 
-use gi_studio::render::{render_blocking, Algorithm, LinearImage, RenderJob, RenderSettings};
+use gi_studio::render::{render_blocking, LinearImage, RenderJob, RenderSettings};
 use gi_studio::scene::presets;
 
 /// (preset, algorithm, FNV-1a of the image's f32 bits).

@@ -11,17 +11,22 @@
 
 use std::f32::consts::FRAC_1_PI;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
+
+mod lights;
+mod samples;
+
+use lights::{CapLight, LightLanes};
+use samples::{CameraSample, CameraSamples};
 
 use super::Counters;
 use crate::geometry::sphere::{nearest_root, roots};
-use crate::geometry::{frame_from_z, gamma, offset_origin, ray_to, to_world, Ray, SurfaceHit};
+use crate::geometry::{frame_from_z, gamma, offset_origin, to_world, SurfaceHit};
 use crate::render::world::bsdf::{reflect_of, refraction_of, Bsdf, Refraction};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
-use crate::render::world::light::{solid_angle_pdf_of, LightSource};
-use crate::render::world::rng::Sampler;
-use crate::render::world::sampling::{cosine_hemisphere_of, power_heuristic, power_heuristic_of, uniform_cone_of};
+use crate::render::world::light::LightSource;
+use crate::render::world::sampling::{cosine_hemisphere_of, power_heuristic, power_heuristic_of};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::{MaterialModel, Rgb};
 
@@ -50,31 +55,6 @@ struct SphereInfo {
     /// Albedo, tint or radiance.
     color: Rgb,
     ior: f32,
-}
-
-/// A sphere light's emitting cap, as light sampling draws it; `None` for
-/// lights the scalar code samples lane by lane.
-#[derive(Clone, Copy, Debug)]
-struct CapLight {
-    center: Vec3,
-    radius: f32,
-    error: f32,
-    frame: [Vec3; 3],
-    one_minus_cos: f32,
-    area: f32,
-    radiance: Rgb,
-}
-
-impl CapLight {
-    const NONE: CapLight = CapLight {
-        center: Vec3::ZERO,
-        radius: 0.0,
-        error: 0.0,
-        frame: [Vec3::X, Vec3::Y, Vec3::Z],
-        one_minus_cos: 0.0,
-        area: 0.0,
-        radiance: Vec3::ZERO,
-    };
 }
 
 /// A sphere as shadow rays test it.
@@ -339,7 +319,7 @@ impl PathLanes {
                 lanes::each(|i| ((u_pick[i] * light_count as f32) as usize).min(light_count - 1))
             };
             let u = st.rng.next_2d(lambert);
-            let light = LightLanes::sample(self, world, &pick, lambert, point, normal, error, u, &hit);
+            let light = LightLanes::sample(&self.lights, world, &pick, lambert, point, normal, error, u, &hit);
             // f = albedo / π where both directions are above the surface
             let above = !light.wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
             let f = color * F8::splat(FRAC_1_PI);
@@ -456,95 +436,6 @@ fn one_by_one(world: &World, tile: &CameraTile, max_depth: u32, out: &mut [Rgb],
     }
 }
 
-/// One camera sample, as a lane takes it up.
-#[derive(Clone, Copy, Debug)]
-struct CameraSample {
-    origin: Vec3,
-    direction: Vec3,
-    stream: u64,
-    /// `Walls::hold` of the origin.
-    inside_walls: bool,
-}
-
-/// A tile's camera samples, a whole number of eights (the last eight repeat
-/// the last sample).
-struct CameraSamples(Vec<CameraSample>);
-
-impl CameraSamples {
-    #[inline(always)]
-    fn new(tile: &CameraTile, world: &World) -> Self {
-        let mut samples = Self::rays(tile);
-        // Camera rays of a tile start close together: mostly all inside the walls
-        let (mut low, mut high) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        for sample in &samples.0 {
-            (low, high) = (low.min(sample.origin), high.max(sample.origin));
-        }
-        if !world.walls.hold_box(low, high) {
-            for entry in samples.0.chunks_exact_mut(LANES) {
-                let held = world.walls.hold_lanes(V8::from_fn(|i| entry[i].origin)).to_array();
-                for (sample, held) in entry.iter_mut().zip(held) {
-                    sample.inside_walls = held != 0;
-                }
-            }
-        }
-        samples
-    }
-
-    /// The rays and their streams.
-    #[inline(always)]
-    fn rays(tile: &CameraTile) -> Self {
-        let entries = tile.len().div_ceil(LANES);
-        let mut samples = CameraSamples(Vec::with_capacity(entries * LANES));
-        let last = tile.len().saturating_sub(1);
-        if tile.camera.has_lens() {
-            for entry in 0..entries {
-                let rays: [(Ray, Sampler); LANES] = lanes::each(|i| tile.sample((entry * LANES + i).min(last)));
-                let origin = V8::from_fn(|i| rays[i].0.origin);
-                samples.push(origin, V8::from_fn(|i| rays[i].0.direction), rays.map(|(_, s)| s.state()));
-            }
-            return samples;
-        }
-        // A pinhole's eight at a time: `sample_ray` lane by lane
-        let rect = tile.rect;
-        let (mut x, mut y) = (rect.x, rect.y);
-        for entry in 0..entries {
-            let (mut column, mut row) = ([0; LANES], [0; LANES]);
-            for lane in 0..LANES {
-                (column[lane], row[lane]) = (x, y);
-                if entry * LANES + lane < last {
-                    x += 1;
-                    if x == rect.x + rect.width {
-                        (x, y) = (rect.x, y + 1);
-                    }
-                }
-            }
-            let stream = |i: usize| tile.streams.sampler(tile.camera.pixel_index(column[i], row[i])).state();
-            let mut rng = Rng8::from_states(lanes::each(stream));
-            let (u0, u1) = rng.next_2d(M8::ALL);
-            let film_x = F8::from_fn(|i| column[i] as f32) + u0;
-            let film_y = F8::from_fn(|i| row[i] as f32) + u1;
-            let (origin, direction) = tile.camera.pinhole_rays_of(film_x, film_y);
-            samples.push(origin, direction, rng.states());
-        }
-        samples
-    }
-
-    /// Eight samples, taken to be inside the walls until `new` knows better.
-    #[inline(always)]
-    fn push(&mut self, origin: V8, direction: V8, stream: [u64; LANES]) {
-        let (ox, oy, oz) = (origin.x.to_array(), origin.y.to_array(), origin.z.to_array());
-        let (dx, dy, dz) = (direction.x.to_array(), direction.y.to_array(), direction.z.to_array());
-        for i in 0..LANES {
-            self.0.push(CameraSample {
-                origin: Vec3::new(ox[i], oy[i], oz[i]),
-                direction: Vec3::new(dx[i], dy[i], dz[i]),
-                stream: stream[i],
-                inside_walls: true,
-            });
-        }
-    }
-}
-
 /// Eight paths in flight.
 struct Lanes {
     active: M8,
@@ -627,125 +518,6 @@ impl Lanes {
             out[slots[lane]] = Rgb::new(x[lane], y[lane], z[lane]);
         }
         self.active = self.active.and_not(mask);
-    }
-}
-
-/// Sphere-cap lights in eight lanes.
-struct CapLanes {
-    center: V8,
-    radius: F8,
-    error: F8,
-    frame: [V8; 3],
-    one_minus_cos: F8,
-    area: F8,
-    radiance: V8,
-}
-
-impl CapLanes {
-    #[inline(always)]
-    fn splat(cap: &CapLight) -> Self {
-        CapLanes {
-            center: V8::splat(cap.center),
-            radius: F8::splat(cap.radius),
-            error: F8::splat(cap.error),
-            frame: cap.frame.map(V8::splat),
-            one_minus_cos: F8::splat(cap.one_minus_cos),
-            area: F8::splat(cap.area),
-            radiance: V8::splat(cap.radiance),
-        }
-    }
-
-    #[inline(always)]
-    fn gather(caps: [&CapLight; LANES]) -> Self {
-        CapLanes {
-            center: V8::from_fn(|i| caps[i].center),
-            radius: F8::from_fn(|i| caps[i].radius),
-            error: F8::from_fn(|i| caps[i].error),
-            frame: std::array::from_fn(|k| V8::from_fn(|i| caps[i].frame[k])),
-            one_minus_cos: F8::from_fn(|i| caps[i].one_minus_cos),
-            area: F8::from_fn(|i| caps[i].area),
-            radiance: V8::from_fn(|i| caps[i].radiance),
-        }
-    }
-}
-
-/// Light samples in eight lanes (only lanes of the mask are meaningful).
-struct LightLanes {
-    valid: M8,
-    delta: M8,
-    wi: V8,
-    /// Radiance over pdf (or the delta light's irradiance).
-    value: V8,
-    pdf: F8,
-    origin: V8,
-    t_max: F8,
-}
-
-impl LightLanes {
-    /// `LightSource::sample` for each lane's light: sphere caps in lanes,
-    /// other lights through the scalar code.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
-    fn sample(
-        lanes: &PathLanes,
-        world: &World,
-        pick: &[usize; LANES],
-        mask: M8,
-        point: V8,
-        normal: V8,
-        error: F8,
-        u: (F8, F8),
-        hit: &impl Fn(usize) -> SurfaceHit,
-    ) -> LightLanes {
-        let cap = |i: usize| lanes.lights[pick[i]].as_ref();
-        let all_caps = lanes.lights.iter().all(Option::is_some);
-        let cap_lanes = if all_caps { mask } else { M8::from_fn(|i| cap(i).is_some()).and(mask) };
-        let mut out = LightLanes {
-            valid: M8::NONE,
-            delta: M8::NONE,
-            wi: V8::splat(Vec3::Z),
-            value: V8::splat(Vec3::ZERO),
-            pdf: F8::splat(0.0),
-            origin: point,
-            t_max: F8::splat(0.0),
-        };
-        if cap_lanes.any() {
-            let caps = match lanes.lights.as_slice() {
-                [Some(only)] => CapLanes::splat(only),
-                _ => {
-                    // Lanes without a cap compute on the first cap, unused
-                    let first = lanes.lights.iter().flatten().next().unwrap_or(&CapLight::NONE);
-                    CapLanes::gather(lanes::each(|i| cap(i).unwrap_or(first)))
-                }
-            };
-            let CapLanes { center, radius, error: light_error, frame, one_minus_cos, area, radiance } = caps;
-
-            // Uniform over the cap (`sample_area`)
-            let light_normal = to_world(frame, uniform_cone_of(u.0, u.1, one_minus_cos));
-            let target = center + light_normal * radius;
-            let pdf = solid_angle_pdf_of(point, target, light_normal, area);
-            // The shadow ray (`SurfaceHit::spawn_ray_to`)
-            let (origin, wi, t_max) = ray_to(point, error, normal, target, light_error);
-            // Emission is one-sided: the light's front must face the point
-            let faces = !light_normal.dot(-wi).le(F8::splat(0.0));
-            let valid = cap_lanes.and(pdf.gt(F8::splat(0.0))).and(faces);
-            out = LightLanes { valid, delta: M8::NONE, wi, value: radiance / pdf, pdf, origin, t_max };
-        }
-        let others = if all_caps { M8::NONE } else { mask.and_not(cap_lanes) };
-        for lane in (0..LANES).filter(|&i| others.test(i)) {
-            let light = &world.lights[pick[lane]];
-            let u = Vec2::new(u.0.lane(lane), u.1.lane(lane));
-            if let Some(sample) = light.sample(&hit(lane), u) {
-                out.valid.set(lane, true);
-                out.delta.set(lane, light.is_delta());
-                out.wi.set_lane(lane, sample.wi);
-                out.value.set_lane(lane, sample.value);
-                out.pdf.set_lane(lane, sample.pdf);
-                out.origin.set_lane(lane, sample.shadow.origin);
-                out.t_max.set_lane(lane, sample.shadow_t_max);
-            }
-        }
-        out
     }
 }
 
