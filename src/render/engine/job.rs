@@ -95,7 +95,7 @@ pub(super) fn run_job(context: &JobContext, job: &RenderJob) {
     context.send(RenderEvent::Started { generation, width: settings.width, height: settings.height });
 
     if settings.preview {
-        film.tiles.par_iter().for_each(|tile| {
+        film.tiles.par_iter().with_max_len(1).for_each(|tile| {
             if context.is_current() {
                 let pixels = integrator.preview_tile(&stage, tile.rect);
                 context.send(RenderEvent::Tile(TileUpdate { generation, rect: tile.rect, pixels, preview: true }));

@@ -188,6 +188,10 @@ impl Integrator {
         let per_tile: Vec<Counters> = film
             .tiles
             .par_iter_mut()
+            // one tile a task: rayon's default leaves are a quarter of the
+            // tiles at two threads, and the thread left with the costly
+            // quarter finishes the pass alone
+            .with_max_len(1)
             .map(|tile| {
                 let mut counters = Counters::default();
                 if observer.is_current() {

@@ -78,6 +78,7 @@ impl Sppm {
         let mut report = PassReport::default();
         let per_tile: Vec<Counters> = (film.tiles.par_iter())
             .zip(self.pixels.par_iter_mut())
+            .with_max_len(1)
             .map(|(tile, pixels)| {
                 let mut counters = Counters::default();
                 if !observer.is_current() {
@@ -115,6 +116,7 @@ impl Sppm {
         let alpha = self.alpha;
         let radii: Vec<(f64, usize)> = (film.tiles.par_iter_mut())
             .zip(self.pixels.par_iter_mut())
+            .with_max_len(1)
             .map(|(tile, pixels)| {
                 if !observer.is_current() {
                     return (0.0, 0);

@@ -42,10 +42,13 @@ pub fn trace_photons(world: &World, kind: MapKind, count: u64, pass: u64, seed: 
         return Vec::new();
     }
     let scale = 1.0 / count as f32;
-    let chunks = count.div_ceil(CHUNK);
+    // usize: rayon splits only ranges of usize by index
+    let chunks = count.div_ceil(CHUNK) as usize;
     let per_chunk: Vec<Vec<Photon>> = (0..chunks)
         .into_par_iter()
+        .with_max_len(1) // balanced by chunk, as the passes are by tile
         .map(|chunk| {
+            let chunk = chunk as u64;
             let mut stored = Vec::new();
             for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(count) {
                 let mut sampler = Sampler::new(index, pass, seed ^ PHOTON_SALT ^ kind as u64);
