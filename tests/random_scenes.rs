@@ -58,7 +58,7 @@ fn light_kind() -> impl Strategy<Value = LightKind> {
 
 fn random_scene() -> impl Strategy<Value = Scene> {
     (
-        (vec3(8.0), vec3(2.0), 5.0f32..170.0, 0.0f32..0.5, 0.0f32..0.3),
+        (vec3(8.0), vec3(2.0), 5.0f32..170.0, 0.0f32..0.5, 0.0f32..0.3, any::<bool>()),
         colour(2.0),
         prop::collection::vec(material_model(), 1..4),
         prop::collection::vec((shape(), 0usize..4), 1..5),
@@ -67,43 +67,53 @@ fn random_scene() -> impl Strategy<Value = Scene> {
             0..3,
         ),
     )
-        .prop_map(|((position, look_at, fov, near_clip, aperture), background, models, shapes, lights)| {
-            let materials: Vec<Material> =
-                models.into_iter().enumerate().map(|(i, model)| Material { name: format!("m{i}"), model }).collect();
-            let count = materials.len();
-            Scene {
-                camera: Camera {
-                    position,
-                    look_at,
-                    up: Vec3::Y,
-                    fov_y_degrees: fov,
-                    near_clip,
-                    aperture_radius: aperture,
-                    focus_distance: 0.0,
-                },
-                background,
-                ambient: Vec3::splat(0.05),
-                settings: SceneSettings { width: 8, height: 6, exposure: 0.0 },
-                objects: shapes
+        .prop_map(
+            |((position, look_at, fov, near_clip, aperture, along_ray), background, models, shapes, lights)| {
+                let materials: Vec<Material> = models
                     .into_iter()
                     .enumerate()
-                    .map(|(i, (shape, m))| Object { name: format!("o{i}"), shape, material: format!("m{}", m % count) })
-                    .collect(),
-                materials,
-                lights: lights
-                    .into_iter()
-                    .enumerate()
-                    .map(|(i, (kind, color, intensity, (a, b, c), enabled))| Light {
-                        name: format!("l{i}"),
-                        kind,
-                        color,
-                        intensity,
-                        attenuation: Attenuation { a, b, c },
-                        enabled,
-                    })
-                    .collect(),
-            }
-        })
+                    .map(|(i, model)| Material { name: format!("m{i}"), model })
+                    .collect();
+                let count = materials.len();
+                Scene {
+                    camera: Camera {
+                        position,
+                        look_at,
+                        up: Vec3::Y,
+                        fov_y_degrees: fov,
+                        near_clip,
+                        near_clip_along: if along_ray { ClipAlong::Ray } else { ClipAlong::ViewAxis },
+                        aperture_radius: aperture,
+                        focus_distance: 0.0,
+                    },
+                    background,
+                    ambient: Vec3::splat(0.05),
+                    settings: SceneSettings { width: 8, height: 6, exposure: 0.0 },
+                    objects: shapes
+                        .into_iter()
+                        .enumerate()
+                        .map(|(i, (shape, m))| Object {
+                            name: format!("o{i}"),
+                            shape,
+                            material: format!("m{}", m % count),
+                        })
+                        .collect(),
+                    materials,
+                    lights: lights
+                        .into_iter()
+                        .enumerate()
+                        .map(|(i, (kind, color, intensity, (a, b, c), enabled))| Light {
+                            name: format!("l{i}"),
+                            kind,
+                            color,
+                            intensity,
+                            attenuation: Attenuation { a, b, c },
+                            enabled,
+                        })
+                        .collect(),
+                }
+            },
+        )
 }
 
 proptest! {

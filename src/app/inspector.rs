@@ -6,7 +6,7 @@
 use eframe::egui;
 use glam::Vec3;
 
-use crate::scene::{Attenuation, Invalid, Light, LightKind, Material, MaterialModel, Object, Scene, Shape};
+use crate::scene::{Attenuation, ClipAlong, Invalid, Light, LightKind, Material, MaterialModel, Object, Scene, Shape};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Selection {
@@ -257,6 +257,11 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
             changed |=
                 ui.add(egui::Slider::new(&mut camera.fov_y_degrees, 1.0..=170.0).text("Field of view °")).changed();
             changed |= scalar_ui(ui, "Near clip", &mut camera.near_clip, 0.0..=f32::MAX, 0.01);
+            ui.horizontal(|ui| {
+                ui.label("measured along");
+                changed |= ui.radio_value(&mut camera.near_clip_along, ClipAlong::ViewAxis, "the view axis").changed();
+                changed |= ui.radio_value(&mut camera.near_clip_along, ClipAlong::Ray, "each ray").changed();
+            });
             changed |= scalar_ui(ui, "Aperture radius", &mut camera.aperture_radius, 0.0..=f32::MAX, 0.001);
             changed |= scalar_ui(ui, "Focus distance (0: look-at)", &mut camera.focus_distance, 0.0..=f32::MAX, 0.01);
             changed |= radiance_ui(ui, "Background", &mut scene.background);

@@ -45,16 +45,37 @@ pub struct Camera {
     pub up: Vec3,
     /// Vertical field of view in degrees.
     pub fov_y_degrees: f32,
-    /// Primary rays start where they cross the plane this far along the view
-    /// axis (smallpt's `+d*140`); 0 starts them at the camera.
+    /// Primary rays start this far from the camera (smallpt's `+d*140`),
+    /// measured as `near_clip_along` says; 0 starts them at the camera.
     #[serde(default)]
     pub near_clip: f32,
+    /// How `near_clip` is measured: along the view axis (rays start on a
+    /// plane, the default) or along each ray (on a sphere about the eye,
+    /// as smallpt's `cam.o + d*140` with `d` already normalised does).
+    #[serde(default, skip_serializing_if = "ClipAlong::is_view_axis")]
+    pub near_clip_along: ClipAlong,
     /// Thin-lens radius; 0 is a pinhole.
     #[serde(default)]
     pub aperture_radius: f32,
     /// Distance of the plane in focus; 0 focuses on `look_at`.
     #[serde(default)]
     pub focus_distance: f32,
+}
+
+/// Where a camera's near clip is measured; see `Camera::near_clip_along`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ClipAlong {
+    /// Rays start on the plane `near_clip` along the view axis.
+    #[default]
+    ViewAxis,
+    /// Rays start `near_clip` along themselves.
+    Ray,
+}
+
+impl ClipAlong {
+    pub fn is_view_axis(&self) -> bool {
+        *self == Self::ViewAxis
+    }
 }
 
 /// What a scene asks of the image by default (flags may override).

@@ -34,7 +34,7 @@ pub fn default_scene() -> Scene {
 }
 
 fn fallback_scene() -> Scene {
-    use super::{Camera, Light, LightKind, Material, MaterialModel, Object, SceneSettings, Shape};
+    use super::{Camera, ClipAlong, Light, LightKind, Material, MaterialModel, Object, SceneSettings, Shape};
     use glam::Vec3;
     Scene {
         camera: Camera {
@@ -43,6 +43,7 @@ fn fallback_scene() -> Scene {
             up: Vec3::Y,
             fov_y_degrees: 40.0,
             near_clip: 0.0,
+            near_clip_along: ClipAlong::ViewAxis,
             aperture_radius: 0.0,
             focus_distance: 0.0,
         },

@@ -17,6 +17,7 @@ pub fn camera(position: Vec3, look_at: Vec3) -> Camera {
         up: Vec3::Y,
         fov_y_degrees: 40.0,
         near_clip: 0.0,
+        near_clip_along: ClipAlong::ViewAxis,
         aperture_radius: 0.0,
         focus_distance: 0.0,
     }

@@ -6,7 +6,7 @@ use crate::geometry::real::{Real, V3};
 use crate::geometry::Ray;
 use crate::render::world::rng::{PassStreams, Sampler};
 use crate::render::world::sampling::concentric_disk;
-use crate::scene::Camera;
+use crate::scene::{Camera, ClipAlong};
 
 #[derive(Clone, Debug)]
 pub struct CameraModel {
@@ -20,6 +20,8 @@ pub struct CameraModel {
     /// A pixel's extent on that plane.
     pixel_size: Vec2,
     near_clip: f32,
+    /// `near_clip` along each ray rather than along the view axis.
+    clip_along_ray: bool,
     aperture_radius: f32,
     focus_distance: f32,
     width: f32,
@@ -50,6 +52,7 @@ impl CameraModel {
             half_height,
             pixel_size: Vec2::new(2.0 * half_width / width as f32, 2.0 * half_height / height as f32),
             near_clip: camera.near_clip,
+            clip_along_ray: camera.near_clip_along == ClipAlong::Ray,
             aperture_radius: camera.aperture_radius,
             focus_distance,
             width: width as f32,
@@ -68,7 +71,8 @@ impl CameraModel {
             let on_lens = self.position + self.right * l.x + self.up * l.y;
             let in_focus = self.position + through * self.focus_distance;
             let direction = (in_focus - on_lens).normalize();
-            Ray::new(on_lens + direction * (self.near_clip / direction.dot(self.forward)), direction)
+            let start = if self.clip_along_ray { self.near_clip } else { self.near_clip / direction.dot(self.forward) };
+            Ray::new(on_lens + direction * start, direction)
         } else {
             let (origin, direction) = self.pinhole_rays_of(film.x, film.y);
             Ray::new(origin.into(), direction.into())
@@ -107,7 +111,10 @@ impl CameraModel {
     #[inline(always)]
     pub(crate) fn pinhole_rays_of<R: Real>(&self, film_x: R, film_y: R) -> (V3<R>, V3<R>) {
         let through = self.through_of(film_x, film_y);
-        (V3::splat(self.position) + through * R::splat(self.near_clip), through.normalize())
+        let direction = through.normalize();
+        // `through` is 1 deep along the view axis, `direction` 1 long
+        let start = if self.clip_along_ray { direction } else { through };
+        (V3::splat(self.position) + start * R::splat(self.near_clip), direction)
     }
 
     /// Whether rays start across a lens (and so need a lens sample).
@@ -197,6 +204,7 @@ mod tests {
             up: Vec3::Y,
             fov_y_degrees: 90.0,
             near_clip: 2.0,
+            near_clip_along: ClipAlong::ViewAxis,
             aperture_radius: 0.0,
             focus_distance: 0.0,
         }
@@ -219,6 +227,27 @@ mod tests {
         let film = model.project(left.at(7.0)).unwrap();
         assert!((film - Vec2::new(0.0, 50.0)).length() < 1e-3, "{film}");
         assert!(model.project(Vec3::new(0.0, 0.0, 9.0)).is_none());
+    }
+
+    #[test]
+    fn near_clip_along_the_ray_starts_every_ray_on_a_sphere_about_the_eye() {
+        for aperture in [0.0, 0.4] {
+            let along_ray = Camera { near_clip_along: ClipAlong::Ray, aperture_radius: aperture, ..camera() };
+            let on_plane = Camera { aperture_radius: aperture, ..camera() };
+            let (sphere, plane) = (CameraModel::new(&along_ray, 200, 100), CameraModel::new(&on_plane, 200, 100));
+            for film in [Vec2::new(100.0, 50.0), Vec2::new(0.0, 0.0), Vec2::new(150.0, 90.0)] {
+                let lens = Vec2::new(0.3, 0.8);
+                let (s, p) = (sphere.generate_ray(film, lens), plane.generate_ray(film, lens));
+                assert!((s.direction - p.direction).length() < 1e-6, "same directions");
+                let eye = s.origin - s.direction * 2.0;
+                // The ray starts 2 along itself from where it leaves the lens
+                assert!((eye.z - 5.0).abs() < 1e-5, "{eye}");
+                // A corner ray on the plane starts further out than on the sphere
+                let extra = (p.origin - s.origin).dot(s.direction);
+                let expected = 2.0 / s.direction.dot(-Vec3::Z) - 2.0;
+                assert!((extra - expected).abs() < 1e-4, "{extra} vs {expected}");
+            }
+        }
     }
 
     #[test]

@@ -322,7 +322,7 @@ mod tests {
         assert_eq!((w.walls.regions.len(), w.walls.planes.len()), (4, 1), "the back wall has a light behind it");
     }
 
-    /// A path that starts outside a wall (smallpt's top rows start above the
+    /// A path that starts outside a wall (a camera above smallpt's
     /// ceiling) tests everything.
     #[test]
     fn paths_from_outside_test_every_sphere() {
