@@ -16,12 +16,12 @@ use gi_studio::scene::presets;
 const GOLDEN: &[(&str, &str, u64)] = &[
     ("cornell", "whitted", 0x80aa3c0ec2f92365),
     ("cornell", "path", 0xe833e0642c370660),
-    ("cornell", "photon", 0xa6bf1191bf239d81),
-    ("cornell", "sppm", 0x9ff35c03be1f7b45),
-    ("smallpt", "whitted", 0xc0831cced898240d),
-    ("smallpt", "path", 0xfaac2ac661e3dbf5),
-    ("smallpt", "photon", 0xb99db0509e7a8091),
-    ("smallpt", "sppm", 0x1b88faca76cfebf8),
+    ("cornell", "photon", 0x3e7ca4681f1e2767),
+    ("cornell", "sppm", 0xabdfaab6eccc921a),
+    ("smallpt", "whitted", 0x88fbbc44b9345a5b),
+    ("smallpt", "path", 0xce8e33ea0c87c9a0),
+    ("smallpt", "photon", 0xb778cd9064e34996),
+    ("smallpt", "sppm", 0x029e9bdbe75cdd7d),
     ("thesis", "whitted", 0xf5a083af67f2ead7),
     ("thesis", "path", 0xbb216807403aa573),
     ("thesis", "photon", 0xade1c0ea041e611a),
@@ -33,7 +33,7 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("caustics", "whitted", 0xb91b2d20a3a39a19),
     ("caustics", "path", 0x254a1bdcdc40f3eb),
     ("caustics", "photon", 0x4cd0fde0f1043e21),
-    ("cornell", "photon+final-gather", 0x98e90179c8680538),
+    ("cornell", "photon+final-gather", 0x9a1e720e38ae8db0),
     ("caustics", "sppm", 0x61a9d04d5163d909),
 ];
 

@@ -11,7 +11,7 @@ mod triangle;
 
 pub use frame::{frame_from_z, to_world, Frame};
 pub use plane::intersect_plane;
-pub(crate) use plane::{plane_hit, plane_t};
+pub(crate) use plane::{plane_exit_t, plane_hit, plane_t};
 pub use ray::{gamma, offset_origin, offset_ray_origin, spawn_offset_scale, Ray};
 pub use sphere::intersect_sphere;
 pub(crate) use sphere::sphere_hit;

@@ -20,6 +20,20 @@ pub(crate) fn plane_t(ray: &Ray, normal: Vec3, offset: f32, t_max: f32) -> Optio
     (t > 0.0 && t < t_max).then_some(t)
 }
 
+/// Where a ray leaves the half-space `inward · x > offset` that holds its
+/// path (an opaque wall's side it started on), in [0, t_max): never while
+/// heading in, and at once (0) where rounding has already put the origin
+/// on the far side heading out; see `sphere::wall_exit`.
+#[inline]
+pub(crate) fn plane_exit_t(ray: &Ray, inward: Vec3, offset: f32, t_max: f32) -> Option<f32> {
+    let denominator = inward.dot(ray.direction);
+    if denominator >= 0.0 {
+        return None;
+    }
+    let t = ((offset - inward.dot(ray.origin)) / denominator).max(0.0);
+    (t < t_max).then_some(t)
+}
+
 #[inline]
 pub(crate) fn plane_hit(ray: &Ray, normal: Vec3, offset: f32, t: f32) -> SurfaceHit {
     // Re-project onto the plane so the error does not grow with t

@@ -7,6 +7,7 @@
 use glam::{Vec2, Vec3};
 
 use super::Counters;
+use crate::geometry::Ray;
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::light::{LightSample, LightSource};
 use crate::render::world::occluders::Occluders;
@@ -15,19 +16,28 @@ use crate::render::world::sampling::power_heuristic;
 use crate::render::world::{Hit, World};
 use crate::scene::Rgb;
 
-/// The world as one path sees it: its shapes, and what can block its
-/// shadow rays (which depends on where the path started).
+/// The world as one path sees it: its shapes, and, depending on where the
+/// path started, whether it is held inside the walls (which it then meets
+/// only on their way out) and what can block its shadow rays.
 #[derive(Clone, Copy)]
 pub struct PathScope<'w> {
     pub world: &'w World,
+    pub held: bool,
     pub occluders: Occluders<'w>,
 }
 
 impl<'w> PathScope<'w> {
-    /// For a path whose camera ray starts at `origin`.
+    /// For a path that starts at `origin` (a camera ray's, a light's).
     #[inline]
     pub fn new(world: &'w World, origin: Vec3) -> Self {
-        Self { world, occluders: world.occluders(origin) }
+        let held = world.holds(origin);
+        Self { world, held, occluders: world.occluders(held) }
+    }
+
+    /// The nearest hit of one of the path's rays.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.world.intersect_held(ray, f32::INFINITY, self.held)
     }
 
     /// One sample of `light` at `hit` (drawn from `u`): what `shade` makes of
@@ -128,7 +138,7 @@ impl<'w> PathScope<'w> {
         }
         let Some(s) = bsdf.sample(wo, hit.surface.normal, sampler, Transport::Radiance) else { return Rgb::ZERO };
         counters.rays += 1;
-        match world.intersect(&hit.surface.spawn_ray(s.wi), f32::INFINITY) {
+        match self.intersect(&hit.surface.spawn_ray(s.wi)) {
             None => throughput * s.weight * world.background,
             Some(_) => Rgb::ZERO,
         }

@@ -60,7 +60,7 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
 
     for depth in 0..max_depth {
         counters.rays += 1;
-        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(hit) = scope.intersect(&ray) else {
             radiance += throughput * world.background;
             break;
         };

@@ -61,7 +61,6 @@ impl PhotonMapping {
         scratch: &mut PhotonScratch,
     ) -> Rgb {
         let renderer = PhotonRenderer {
-            world,
             scope: PathScope::new(world, ray.origin),
             maps: &self.maps,
             settings: &self.settings,
@@ -82,7 +81,6 @@ impl PhotonMapping {
 }
 
 struct PhotonRenderer<'a> {
-    world: &'a World,
     /// The world as the path being traced sees it.
     scope: PathScope<'a>,
     maps: &'a PhotonMaps,
@@ -102,7 +100,7 @@ impl PhotonRenderer<'_> {
         counters: &mut Counters,
         scratch: &mut PhotonScratch,
     ) -> Rgb {
-        let (radiance, landing) = follow_specular(self.world, ray, self.max_depth, Emission::Count, sampler, counters);
+        let (radiance, landing) = follow_specular(&self.scope, ray, self.max_depth, Emission::Count, sampler, counters);
         let Some(Landing { hit, wo, bsdf, throughput }) = landing else { return radiance };
         radiance + throughput * self.shade(&hit, wo, &bsdf, self.settings.final_gather, sampler, counters, scratch)
     }
@@ -143,7 +141,8 @@ impl PhotonRenderer<'_> {
     /// mirrors) are skipped: direct light and caustics already count them.
     fn gathered(&self, ray: Ray, sampler: &mut Sampler, counters: &mut Counters, scratch: &mut PhotonScratch) -> Rgb {
         let emission = Emission::Skip;
-        let (radiance, landing) = follow_specular(self.world, &ray, GATHER_SPECULAR_DEPTH, emission, sampler, counters);
+        let (radiance, landing) =
+            follow_specular(&self.scope, &ray, GATHER_SPECULAR_DEPTH, emission, sampler, counters);
         let Some(Landing { hit, wo, bsdf, throughput }) = landing else { return radiance };
         let n = hit.surface.normal;
         let facing = if wo.dot(n) < 0.0 { -n } else { n };

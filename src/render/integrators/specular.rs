@@ -5,11 +5,12 @@
 
 use glam::Vec3;
 
+use super::next_event::PathScope;
 use super::Counters;
 use crate::geometry::Ray;
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::rng::Sampler;
-use crate::render::world::{Hit, World};
+use crate::render::world::Hit;
 use crate::scene::Rgb;
 
 /// The first non-specular surface a camera path reaches.
@@ -35,19 +36,20 @@ pub enum Emission {
 /// Follow `ray` for at most `max_depth` segments: the radiance gathered on
 /// the way and the landing, if the path reaches one.
 pub fn follow_specular(
-    world: &World,
+    scope: &PathScope,
     ray: &Ray,
     max_depth: u32,
     emission: Emission,
     sampler: &mut Sampler,
     counters: &mut Counters,
 ) -> (Rgb, Option<Landing>) {
+    let world = scope.world;
     let mut ray = *ray;
     let mut throughput = Rgb::ONE;
     let mut radiance = Rgb::ZERO;
     for _ in 0..max_depth {
         counters.rays += 1;
-        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(hit) = scope.intersect(&ray) else {
             return (radiance + throughput * world.background, None);
         };
         let wo = -ray.direction;

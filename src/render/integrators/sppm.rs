@@ -212,7 +212,7 @@ pub fn camera_pass(
     counters: &mut Counters,
 ) -> (Rgb, Option<VisiblePoint>) {
     let scope = PathScope::new(world, ray.origin);
-    let (mut radiance, landing) = follow_specular(world, ray, max_depth, Emission::Count, sampler, counters);
+    let (mut radiance, landing) = follow_specular(&scope, ray, max_depth, Emission::Count, sampler, counters);
     let Some(Landing { hit, wo, bsdf, throughput }) = landing else { return (radiance, None) };
     let n = hit.surface.normal;
     let facing = if wo.dot(n) < 0.0 { -n } else { n };

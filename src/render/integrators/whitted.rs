@@ -61,7 +61,7 @@ fn trace(
 ) -> Rgb {
     let world = scope.world;
     counters.rays += 1;
-    let Some(hit) = world.intersect(ray, f32::INFINITY) else {
+    let Some(hit) = scope.intersect(ray) else {
         return world.background;
     };
     let wo = -ray.direction;

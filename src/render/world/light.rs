@@ -18,7 +18,8 @@ use crate::scene::{Attenuation, Rgb};
 pub struct EmitterCap {
     pub frame: Frame,
     pub one_minus_cos: f32,
-    /// The sphere whose inside the cap was cut to, if any.
+    /// The object (an opaque sphere or plane) whose inside the cap was cut
+    /// to, if any.
     pub wall: Option<u32>,
 }
 
@@ -44,6 +45,19 @@ impl EmitterCap {
             return Self::WHOLE;
         }
         EmitterCap { frame: Frame::from_z(axis), one_minus_cos, wall: None }
+    }
+
+    /// The part of the sphere (`center`, `radius`) in the half-space
+    /// `inward · x > offset`: p = c + r·w there ⇔ inward · w > (offset −
+    /// inward · c)/r, a cap about `inward`. In f64, as `inside`.
+    pub fn in_half_space(center: Vec3, radius: f32, inward: Vec3, offset: f32) -> Self {
+        let inward = inward.as_dvec3().normalize();
+        let cos_min = (offset as f64 - inward.dot(center.as_dvec3())) / radius as f64;
+        let one_minus_cos = (1.0 - cos_min).clamp(0.0, 2.0) as f32;
+        if one_minus_cos >= 2.0 {
+            return Self::WHOLE;
+        }
+        EmitterCap { frame: Frame::from_z(inward.as_vec3()), one_minus_cos, wall: None }
     }
 
     pub fn is_whole(&self) -> bool {

@@ -14,14 +14,26 @@ pub mod spheres;
 
 use glam::Vec3;
 
+use crate::geometry::real::V3;
+use crate::geometry::sphere::{wall_exit, wall_exit_hit, wall_slack};
 use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
-use crate::geometry::{plane_hit, plane_t, sphere_hit};
+use crate::geometry::{plane_exit_t, plane_hit, plane_t, sphere_hit};
 use crate::scene::{LightKind, MaterialModel, Rgb, Shape, ValidScene};
 use camera::CameraModel;
 use light::{Emitter, EmitterCap, LightSource};
 use occluders::{Occluders, Walls};
 pub use shapes::{ObjectInfo, PlaneShape, ShapeRef, Spheres};
 use spheres::SphereLanes;
+
+/// What `intersect_held` found nearest.
+enum Inside<'w> {
+    /// Sphere `i` of the world, entered (near root) or left.
+    Sphere(u32, bool),
+    /// Wall sphere `k` of `Walls::wall_spheres`, left.
+    Wall(usize),
+    Plane(&'w PlaneShape),
+    Triangle(u32),
+}
 
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
@@ -209,12 +221,84 @@ impl World {
         Some(Hit { surface, object, material: self.objects[object as usize].material })
     }
 
-    /// What can block the shadow rays of a path whose camera ray starts at
-    /// `origin` (see `Occluders`).
+    /// Whether a path starting at `origin` is inside every wall (see
+    /// `Walls`): its shadow rays skip them, its rays meet them only on
+    /// their way out.
     #[inline]
-    pub fn occluders(&self, origin: Vec3) -> Occluders<'_> {
+    pub fn holds(&self, origin: Vec3) -> bool {
+        self.walls.hold(origin)
+    }
+
+    /// What can block the shadow rays of a path `held` inside every wall or not.
+    #[inline]
+    pub fn occluders(&self, held: bool) -> Occluders<'_> {
         let s = self;
-        Occluders::for_path(&s.walls, &s.spheres.lanes, &s.planes, &s.triangles, &s.light_plane, origin)
+        Occluders::for_path(&s.walls, &s.spheres.lanes, &s.planes, &s.triangles, &s.light_plane, held)
+    }
+
+    /// `intersect` for a path `held` inside every wall (`holds` of where it
+    /// started): it meets the walls only on their way out, and at once
+    /// where rounding has put it just outside one (at the seam of two
+    /// walls, whose hits lie within each other's error), so it never
+    /// leaves the room.
+    #[inline]
+    pub fn intersect_held(&self, ray: &Ray, t_max: f32, held: bool) -> Option<Hit> {
+        if !held {
+            return self.intersect(ray, t_max);
+        }
+        let walls = &self.walls;
+        let s = &self.spheres;
+        let mut best_t = t_max;
+        let mut best = None;
+        if let Some((i, t, near)) = walls.spheres.nearest(ray, best_t) {
+            best_t = t;
+            best = Some(Inside::Sphere(walls.spheres.id(i), near));
+        }
+        let (origin, direction) = (V3::from(ray.origin), V3::from(ray.direction));
+        for (k, (_, wall)) in walls.wall_spheres.iter().enumerate() {
+            let (anchor, normal) = (V3::from(wall.anchor), V3::from(wall.normal));
+            let (t, hit) = wall_exit(origin, direction, anchor, normal, wall.radius, best_t);
+            if hit {
+                best_t = t;
+                best = Some(Inside::Wall(k));
+            }
+        }
+        for plane in &walls.planes {
+            if let Some(t) = plane_t(ray, plane.normal, plane.offset, best_t) {
+                best_t = t;
+                best = Some(Inside::Plane(plane));
+            }
+        }
+        for wall in &walls.wall_planes {
+            if let Some(t) = plane_exit_t(ray, wall.inward, wall.offset, best_t) {
+                best_t = t;
+                best = Some(Inside::Plane(&wall.plane));
+            }
+        }
+        let mut triangle_hit = None;
+        for (i, (triangle, _)) in self.triangles.iter().enumerate() {
+            if let Some(hit) = intersect_triangle(ray, triangle, best_t) {
+                best_t = hit.t;
+                best = Some(Inside::Triangle(i as u32));
+                triangle_hit = Some(hit);
+            }
+        }
+        let (surface, object) = match best? {
+            Inside::Sphere(i, near) => {
+                let i = i as usize;
+                (sphere_hit(ray, s.center(i), s.radius[i], best_t, near), s.object[i])
+            }
+            Inside::Wall(k) => {
+                let (i, wall) = &walls.wall_spheres[k];
+                let center = V3::from(s.center(*i as usize));
+                let (point, normal, error) = wall_exit_hit(origin, direction, best_t, center, wall_slack(wall));
+                let surface = SurfaceHit { t: best_t, point: point.into(), normal: normal.into(), error };
+                (surface, s.object[*i as usize])
+            }
+            Inside::Plane(plane) => (plane_hit(ray, plane.normal, plane.offset, best_t), plane.object),
+            Inside::Triangle(i) => (triangle_hit?, self.triangles[i as usize].1),
+        };
+        Some(Hit { surface, object, material: self.objects[object as usize].material })
     }
 
     /// Whether anything lies on the ray in (0, t_max): shadow rays stop at the
@@ -306,8 +390,9 @@ impl World {
     }
 
     /// Each emissive sphere's cap:
-    /// - its part inside an opaque sphere that holds the camera (`eye`, where
-    ///   its central ray starts), the smallest such part.
+    /// - its part inside an opaque sphere, or on the camera's side of an
+    ///   opaque plane, that holds the camera (`eye`, where its central ray
+    ///   starts), the smallest such part.
     ///   Paths that start inside that wall never leave it, so this is exactly
     ///   what they can see; paths outside it find every light sample blocked
     ///   and get the light through BSDF sampling alone, at full MIS weight.
@@ -327,19 +412,36 @@ impl World {
                 .collect(),
             None => Vec::new(),
         };
+        // Opaque planes, with the normal of the camera's side
+        let sides: Vec<(Vec3, f32, u32)> = match eye {
+            Some(eye) => (self.planes.iter())
+                .filter(|p| {
+                    let material = &self.materials[self.objects[p.object as usize].material as usize];
+                    !matches!(material, MaterialModel::Glass { .. } | MaterialModel::Emissive { .. })
+                })
+                .filter_map(|p| {
+                    let side = (p.normal.dot(eye) - p.offset).signum();
+                    (side != 0.0).then_some((p.normal * side, p.offset * side, p.object))
+                })
+                .collect(),
+            None => Vec::new(),
+        };
         (0..count)
             .map(|i| {
                 if !matches!(material(i), MaterialModel::Emissive { .. }) {
                     return EmitterCap::WHOLE;
                 }
                 let (center, radius) = (s.center(i), s.radius[i]);
-                enclosing
-                    .iter()
-                    .filter(|&&j| j != i)
-                    .map(|&j| EmitterCap {
-                        wall: Some(j as u32),
-                        ..EmitterCap::inside(center, radius, s.center(j), s.radius[j])
-                    })
+                let in_spheres = (enclosing.iter().filter(|&&j| j != i)).map(|&j| EmitterCap {
+                    wall: Some(s.object[j]),
+                    ..EmitterCap::inside(center, radius, s.center(j), s.radius[j])
+                });
+                let in_half_spaces = sides.iter().map(|&(inward, offset, object)| EmitterCap {
+                    wall: Some(object),
+                    ..EmitterCap::in_half_space(center, radius, inward, offset)
+                });
+                (in_spheres.chain(in_half_spaces))
+                    .filter(|cap| !cap.is_whole())
                     .min_by(|a, b| a.one_minus_cos.total_cmp(&b.one_minus_cos))
                     .unwrap_or_else(|| self.region_cap(center, radius))
             })

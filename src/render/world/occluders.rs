@@ -15,6 +15,7 @@ use super::lanes::{F8, LANES, M8, V8};
 use super::light::{Emitter, LightSample, LightSource};
 use super::shapes::{PlaneShape, Spheres};
 use super::spheres::SphereLanes;
+use crate::geometry::sphere::AnchoredSphere;
 use crate::geometry::Triangle;
 use crate::geometry::{gamma, intersect_triangle, plane_t};
 
@@ -90,14 +91,27 @@ impl Region {
 }
 
 /// Walls that shadow rays from inside all of them may skip, and the rest.
+/// Paths inside every wall also meet them only on their way out
+/// (`World::intersect_held`), so none ever leaves the room.
 #[derive(Clone, Debug, Default)]
 pub struct Walls {
     regions: Vec<Region>,
     /// The spheres and planes that are not walls.
-    spheres: SphereLanes,
-    planes: Vec<PlaneShape>,
-    /// Per sphere of the world, whether it is a wall.
-    pub(crate) is_wall_sphere: Vec<bool>,
+    pub(crate) spheres: SphereLanes,
+    pub(crate) planes: Vec<PlaneShape>,
+    /// The walls as intersection tests them: spheres by their index in the
+    /// world, about their point nearest the camera; planes with the normal
+    /// of the camera's side.
+    pub(crate) wall_spheres: Vec<(u32, AnchoredSphere)>,
+    pub(crate) wall_planes: Vec<WallPlane>,
+}
+
+/// A plane that is a wall: the plane, and `inward · x > offset` its inside.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WallPlane {
+    pub plane: PlaneShape,
+    pub inward: Vec3,
+    pub offset: f32,
 }
 
 impl Walls {
@@ -112,26 +126,26 @@ impl Walls {
         lights: &[LightSource],
         eye: Vec3,
     ) -> Self {
+        let eye_f32 = eye;
         let eye = eye.as_dvec3();
         let is_wall = |region: &Region, object: u32| {
             opaque(object)
                 && region.holds_strictly(eye)
-                && lights.iter().all(|light| holds_samples(spheres, light, region, object))
+                && lights.iter().all(|light| holds_samples(light, region, object))
         };
         let s = spheres;
-        let (mut regions, mut others) = (Vec::new(), Vec::new());
-        let mut is_wall_sphere = Vec::with_capacity(s.radius.len());
+        let (mut regions, mut others, mut wall_spheres) = (Vec::new(), Vec::new(), Vec::new());
         for j in 0..s.radius.len() {
             let region = Region::ball(s.center(j), s.radius[j]);
             let wall = is_wall(&region, s.object[j]);
             if wall {
                 regions.push(region);
+                wall_spheres.push((j as u32, AnchoredSphere::new(s.center(j), s.radius[j], eye_f32)));
             } else {
                 others.push(j);
             }
-            is_wall_sphere.push(wall);
         }
-        let mut kept_planes = Vec::new();
+        let (mut kept_planes, mut wall_planes) = (Vec::new(), Vec::new());
         for plane in planes {
             // Facing the camera's side
             let (normal, offset) = (plane.normal.as_dvec3(), plane.offset as f64);
@@ -139,6 +153,8 @@ impl Walls {
             let region = Region::HalfSpace { normal: normal * side, offset: offset * side };
             if is_wall(&region, plane.object) {
                 regions.push(region);
+                let (inward, offset) = (plane.normal * side as f32, plane.offset * side as f32);
+                wall_planes.push(WallPlane { plane: *plane, inward, offset });
             } else {
                 kept_planes.push(*plane);
             }
@@ -149,7 +165,13 @@ impl Walls {
         let centers: Vec<Vec3> = others.iter().map(|&j| s.center(j)).collect();
         let radii: Vec<f32> = others.iter().map(|&j| s.radius[j]).collect();
         let ids = others.iter().map(|&j| j as u32).collect();
-        Walls { regions, spheres: SphereLanes::new(&centers, &radii, ids), planes: kept_planes, is_wall_sphere }
+        Walls {
+            regions,
+            spheres: SphereLanes::new(&centers, &radii, ids),
+            planes: kept_planes,
+            wall_spheres,
+            wall_planes,
+        }
     }
 
     /// Whether a path starting at `origin` is inside every wall (and there are walls).
@@ -199,7 +221,7 @@ impl Walls {
 
 /// Whether every sample `light` can give lies in `region`, the inside of
 /// the wall `object`.
-fn holds_samples(spheres: &Spheres, light: &LightSource, region: &Region, object: u32) -> bool {
+fn holds_samples(light: &LightSource, region: &Region, object: u32) -> bool {
     match *light {
         LightSource::Point { position, .. } | LightSource::Spot { position, .. } => {
             region.holds(position.as_dvec3(), 0.0)
@@ -207,7 +229,7 @@ fn holds_samples(spheres: &Spheres, light: &LightSource, region: &Region, object
         LightSource::Directional { .. } => false,
         LightSource::Area { ref emitter, .. } => match *emitter {
             Emitter::Sphere { center, radius, cap, .. } => {
-                if cap.wall.is_some_and(|wall| spheres.object[wall as usize] == object) {
+                if cap.wall == Some(object) {
                     // Cut to this wall's inside: in it by construction
                     return true;
                 }
@@ -237,8 +259,8 @@ pub struct Occluders<'w> {
 }
 
 impl<'w> Occluders<'w> {
-    /// For a path whose camera ray starts at `origin`: without the walls
-    /// when it starts inside them all.
+    /// For a path that is `held` inside every wall (`Walls::hold` of where
+    /// it started): without the walls.
     #[inline]
     pub fn for_path(
         walls: &'w Walls,
@@ -246,10 +268,9 @@ impl<'w> Occluders<'w> {
         planes: &'w [PlaneShape],
         triangles: &'w [(Triangle, u32)],
         light_plane: &'w [u32],
-        origin: Vec3,
+        held: bool,
     ) -> Self {
-        let (spheres, planes) =
-            if walls.hold(origin) { (&walls.spheres, &walls.planes[..]) } else { (spheres, planes) };
+        let (spheres, planes) = if held { (&walls.spheres, &walls.planes[..]) } else { (spheres, planes) };
         Occluders { spheres, planes, triangles, light_plane }
     }
 
@@ -327,8 +348,8 @@ mod tests {
     #[test]
     fn paths_from_outside_test_every_sphere() {
         let w = world(&preset("smallpt"));
-        assert_eq!(w.occluders(Vec3::new(50.0, 52.0, 150.0)).spheres.len(), 3);
-        assert_eq!(w.occluders(Vec3::new(50.0, 82.0, 150.0)).spheres.len(), 9);
+        assert_eq!(w.occluders(w.holds(Vec3::new(50.0, 52.0, 150.0))).spheres.len(), 3);
+        assert_eq!(w.occluders(w.holds(Vec3::new(50.0, 82.0, 150.0))).spheres.len(), 9);
     }
 
     /// The f32 shortcut answers as f64 does, on points within a few ulps of
@@ -459,7 +480,7 @@ mod tests {
             let (mut samples, mut blocked, mut skipping_paths, mut leaks) = (0u32, 0u32, 0u32, 0u32);
             for _ in 0..4000 {
                 let mut ray = camera.pixel_ray(64.0 * s.next_f32(), 48.0 * s.next_f32());
-                let occluders = w.occluders(ray.origin);
+                let occluders = w.occluders(w.holds(ray.origin));
                 let skips = occluders.spheres.len() + occluders.planes.len() < w.spheres.lanes.len() + w.planes.len();
                 skipping_paths += skips as u32;
                 for _ in 0..4 {

@@ -38,6 +38,12 @@ impl SphereLanes {
         }
     }
 
+    /// The world's index of the sphere in lane `i`.
+    #[inline]
+    pub fn id(&self, i: usize) -> u32 {
+        self.ids[i]
+    }
+
     pub fn len(&self) -> usize {
         self.ids.len()
     }

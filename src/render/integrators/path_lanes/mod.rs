@@ -20,7 +20,7 @@ use lights::{CapLight, LightLanes};
 use samples::{CameraSample, CameraSamples};
 
 use super::Counters;
-use crate::geometry::sphere::{nearest_root, roots};
+use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{frame_from_z, gamma, offset_origin, to_world, SurfaceHit};
 use crate::render::world::bsdf::{reflect_of, refraction_of, Bsdf, Refraction};
 use crate::render::world::camera::CameraTile;
@@ -52,6 +52,11 @@ struct SphereInfo {
     object: u32,
     /// `LAMBERT`, `MIRROR`, `GLASS` or `EMITTER`.
     kind: f32,
+    /// A wall (`occluders::Walls`), about its point nearest the camera:
+    /// paths inside every wall meet it only on their way out (`wall_exit`),
+    /// with this `wall_slack`.
+    wall: Option<AnchoredSphere>,
+    wall_slack: f32,
     /// Albedo, tint or radiance.
     color: Rgb,
     ior: f32,
@@ -89,6 +94,7 @@ impl PathLanes {
             return None;
         }
         let s = &world.spheres;
+        let wall = |i: usize| world.walls.wall_spheres.iter().find(|(j, _)| *j as usize == i).map(|(_, w)| *w);
         let spheres = (0..s.radius.len())
             .map(|i| {
                 let object = s.object[i];
@@ -108,6 +114,8 @@ impl PathLanes {
                     error: gamma(6) * (center.abs().max_element() + radius),
                     object,
                     kind,
+                    wall: wall(i),
+                    wall_slack: wall(i).map_or(0.0, |w| wall_slack(&w)),
                     color,
                     ior,
                 })
@@ -139,13 +147,12 @@ impl PathLanes {
                 })
             })
             .collect();
-        let is_wall = |i: usize| world.walls.is_wall_sphere.get(i).copied().unwrap_or(false);
         let occluder = |i: usize| Occluder {
             center: spheres[i].center,
             radius2: spheres[i].radius2,
             emitter: light_spheres.contains(&Some(i as u32)).then_some(i as u32),
         };
-        let (walls, others) = (0..spheres.len()).partition::<Vec<_>, _>(|&i| is_wall(i));
+        let (walls, others) = (0..spheres.len()).partition::<Vec<_>, _>(|&i| spheres[i].wall.is_some());
         Some(PathLanes {
             others: others.into_iter().map(occluder).collect(),
             walls: walls.into_iter().map(occluder).collect(),
@@ -236,14 +243,35 @@ impl PathLanes {
         counters.rays += active.count();
         let (origin, direction) = (st.origin, st.direction);
 
-        // Nearest sphere, in index order: ties keep the first, as `SphereLanes::nearest`
+        // Nearest sphere, in index order: ties keep the first, as
+        // `SphereLanes::nearest`; paths inside the walls meet them only on
+        // their way out, as `World::intersect_held`
+        let held = st.inside_walls;
+        // Usually every path is inside the walls: then their near roots are never asked
+        let every_held = !active.and_not(held).any();
         let mut t_hit = F8::splat(f32::INFINITY);
         // The index in a float lane, counted there too: one blend per sphere
         let mut index = F8::splat(0.0);
         let mut k = F8::splat(0.0);
         for sphere in &self.spheres {
             let f = origin - V8::splat(sphere.center);
-            let (t, closer, _) = nearest_root(f, direction, F8::splat(sphere.radius2), t_hit);
+            let radius2 = F8::splat(sphere.radius2);
+            let (t, closer) = match sphere.wall {
+                Some(wall) if held.any() => {
+                    let (anchor, normal) = (V8::splat(wall.anchor), V8::splat(wall.normal));
+                    let (t_exit, exits) = wall_exit(origin, direction, anchor, normal, F8::splat(wall.radius), t_hit);
+                    if every_held {
+                        (t_exit, exits)
+                    } else {
+                        let (t, closer, _) = nearest_root(f, direction, radius2, t_hit);
+                        (held.select(t_exit, t), held.select_mask(exits, closer))
+                    }
+                }
+                _ => {
+                    let (t, closer, _) = nearest_root(f, direction, radius2, t_hit);
+                    (t, closer)
+                }
+            };
             t_hit = closer.select(t, t_hit);
             index = closer.select(k, index);
             k = k + 1.0;
@@ -270,17 +298,30 @@ impl PathLanes {
         // The hit, rebuilt from the closest approach as `sphere_hit` does
         let center = V8::from_fn(|i| sphere[i].center);
         let radius = F8::from_fn(|i| sphere[i].radius);
-        let error = F8::from_fn(|i| sphere[i].error);
-        let f = origin - center;
-        // Which root `roots` took (solved again: cheaper than tracking it through the search)
-        let (near_root, _, discriminant) = roots(f, direction, radius * radius);
-        let near = near_root.gt(F8::splat(0.0));
-        let closest = f - direction * f.dot(direction);
-        let half_chord = discriminant.max(F8::splat(0.0)).sqrt();
-        let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
-        let length = from_center.length();
-        let normal = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
-        let point = center + normal * radius;
+        // A wall holding the path is left where `wall_exit` found it
+        let leaving = held.and(M8::from_fn(|i| sphere[i].wall.is_some())).and(alive);
+        let (mut point, mut normal, mut error) = (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
+        if alive.and_not(leaving).any() {
+            let f = origin - center;
+            // Which root `roots` took (solved again: cheaper than tracking
+            // it through the search)
+            let (near_root, _, discriminant) = roots(f, direction, radius * radius);
+            let near = near_root.gt(F8::splat(0.0));
+            let closest = f - direction * f.dot(direction);
+            let half_chord = discriminant.max(F8::splat(0.0)).sqrt();
+            let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
+            let length = from_center.length();
+            normal = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
+            point = center + normal * radius;
+            error = F8::from_fn(|i| sphere[i].error);
+        }
+        if leaving.any() {
+            let slack = F8::from_fn(|i| sphere[i].wall_slack);
+            let (p, n, e) = wall_exit_hit(origin, direction, t_hit, center, slack);
+            point = leaving.select_v(p, point);
+            normal = leaving.select_v(n, normal);
+            error = leaving.select(e, error);
+        }
         let wo = -direction;
         let hit = |i: usize| SurfaceHit {
             t: t_hit.lane(i),

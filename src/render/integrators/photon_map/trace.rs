@@ -76,10 +76,11 @@ fn trace_one(
     stored: &mut Vec<Photon>,
 ) {
     let EmittedPhoton { mut ray, mut power } = emitted;
+    let held = world.holds(ray.origin);
     power *= scale;
     let mut diffuse_bounces = 0;
     for depth in 0..max_depth {
-        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(hit) = world.intersect_held(&ray, f32::INFINITY, held) else {
             return;
         };
         let bsdf = Bsdf::new(world.material_of(&hit));
