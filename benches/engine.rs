@@ -61,7 +61,7 @@ fn whitted_cornell(c: &mut Criterion) {
     group.bench_function("whitted_cornell_640x480_frame", |b| b.iter(|| render_blocking(&job).map(|r| r.1.rays)));
     // The studio's case: a long-lived session restarted by an edit; time
     // until the whole coarse preview has arrived
-    let session = RenderSession::new(None).unwrap();
+    let session = RenderSession::new(gi_studio::render::Workers::shared().unwrap(), None).unwrap();
     let preview = RenderJob::new(scene, RenderSettings { preview: true, samples_per_pixel: Some(0), ..settings });
     group.bench_function("whitted_cornell_640x480_first_coarse_frame_after_edit", |b| {
         b.iter(|| {

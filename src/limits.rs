@@ -68,12 +68,14 @@ impl<T: fmt::Display> fmt::Display for Limit<T> {
 
 /// Width or height of an image, in pixels.
 pub const IMAGE_SIDE: Limit<u32> = Limit::inclusive(1, 16_384);
-/// Pixels in one image: 2²⁵ (8192 × 4096); the film keeps about 40 bytes
-/// a pixel, so at most about 1.3 GB.
+/// Pixels in one image: 2²⁵ (8192 × 4096); the film keeps about 64 bytes
+/// a pixel (sums, the odd passes' sums, the image), so at most about 2 GB.
 pub const IMAGE_PIXELS: u64 = 1 << 25;
 pub const SAMPLES_PER_PIXEL: Limit<u32> = Limit::inclusive(1, 1_000_000);
 /// A wall-clock budget: up to a week.
 pub const SECONDS: Limit<f64> = Limit::above(0.0, 604_800.0);
+/// A time that may be none at all (0: do not).
+pub const SECONDS_OR_NONE: Limit<f64> = Limit::inclusive(0.0, 604_800.0);
 pub const EXPOSURE_STOPS: Limit<f32> = Limit::inclusive(-64.0, 64.0);
 pub const MAX_DEPTH: Limit<u32> = Limit::inclusive(1, 1024);
 /// Worker threads; 0 means one per core.
@@ -92,6 +94,10 @@ pub const SPPM_ALPHA: Limit<f32> = Limit::above(0.0, 1.0);
 pub const STORED_PHOTONS: u64 = 200_000_000;
 /// Scene files, the studio's state file and reference metadata.
 pub const TEXT_FILE_BYTES: u64 = 16 << 20;
+/// The reference cache's size; the least recently used go beyond it.
+pub const REFERENCE_CACHE_BYTES: u64 = 512 << 20;
+/// Render threads of the studio's background reference.
+pub const REFERENCE_THREADS: Limit<usize> = Limit::inclusive(1, 256);
 
 /// The pixel count of `width × height`, refused beyond `IMAGE_PIXELS`.
 pub fn check_image_size(width: u32, height: u32) -> Result<(), OutOfRange> {

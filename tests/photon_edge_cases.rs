@@ -50,7 +50,7 @@ fn sppm_radii_stay_positive_over_thousands_of_passes() {
     let scene = presets::preset("cornell").unwrap().unwrap();
     let mut s = settings(Algorithm::Sppm, 4, 3, 2000);
     s.set_photons(500);
-    let session = gi_studio::render::RenderSession::new(None).unwrap();
+    let session = gi_studio::render::RenderSession::new(gi_studio::render::Workers::shared().unwrap(), None).unwrap();
     let generation = session.start(RenderJob::new(Arc::new(valid(scene)), s));
     let mut last_radius = f32::INFINITY;
     for event in session.events().iter() {

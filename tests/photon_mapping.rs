@@ -96,7 +96,7 @@ fn sppm_error_keeps_falling() {
     let reference = render(&scene, settings(Algorithm::Path, 40, 30, 4096));
     let mut sppm = settings(Algorithm::Sppm, 40, 30, 64);
     sppm.set_photons(20_000);
-    let session = RenderSession::new(None).unwrap();
+    let session = RenderSession::new(gi_studio::render::Workers::shared().unwrap(), None).unwrap();
     let generation = session.start(RenderJob::new(Arc::new(valid(scene)), sppm));
     let mut errors = Vec::new();
     let mut current = LinearImage::new(40, 30);
@@ -269,7 +269,7 @@ fn a_light_larger_than_the_scene_delivers_the_right_power() {
     let reference = LinearImage::load(std::path::Path::new(&path)).unwrap().downsample(8);
     let mut s = settings(Algorithm::Sppm, reference.width, reference.height, 64);
     s.set_photons(50_000);
-    let session = RenderSession::new(None).unwrap();
+    let session = RenderSession::new(gi_studio::render::Workers::shared().unwrap(), None).unwrap();
     let generation = session.start(RenderJob::new(Arc::new(valid(scene)), s));
     let mut image = LinearImage::new(reference.width, reference.height);
     let mut errors = Vec::new();

@@ -170,13 +170,8 @@ fn apply(text: &str, mutation: &Mutation) -> String {
 
 /// A scene that loads renders: a tiny image, finite and not negative.
 fn render_tiny(scene: ValidScene, algorithm: Algorithm) {
-    let mut settings = RenderSettings {
-        width: 8,
-        height: 6,
-        samples_per_pixel: Some(1),
-        threads: 1,
-        ..RenderSettings::for_algorithm(algorithm)
-    };
+    let mut settings =
+        RenderSettings { width: 8, height: 6, samples_per_pixel: Some(1), ..RenderSettings::for_algorithm(algorithm) };
     settings.set_photons(200);
     let (image, _) = render_blocking(&RenderJob::new(Arc::new(valid(scene)), settings)).expect("a valid scene renders");
     assert!(image.pixels.iter().flatten().all(|c| c.is_finite() && *c >= 0.0), "{algorithm}");
@@ -260,7 +255,7 @@ fn any_flags_give_an_error_or_settings_within_limits() {
             if let Ok(settings) = args.flags.settings(&scene) {
                 prop_assert_eq!(settings.problems(), vec![]);
                 prop_assert!(settings.width as u64 * settings.height as u64 <= gi_studio::limits::IMAGE_PIXELS);
-                prop_assert!(settings.threads <= gi_studio::limits::THREADS.max);
+                prop_assert!(args.flags.threads <= gi_studio::limits::THREADS.max);
                 accepted.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             }
         });

@@ -285,16 +285,15 @@ fn a_screenshot_run_never_touches_the_saved_state() {
     assert_eq!(storage.0, before);
 }
 
-/// Saved settings no render can use (a pane of 100000², k = 2³²−1, 100000
-/// threads, tiles of 0, a NaN exposure) fall back to defaults with a notice;
-/// the studio starts and renders.
+/// Saved settings no render can use (a pane of 100000², k = 2³²−1, tiles
+/// of 0, a NaN exposure, 100000 reference threads) fall back to defaults
+/// with a notice; the studio starts and renders.
 #[test]
 fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
     let mut storage = MemoryStorage::default();
     let broken = gi_studio::render::RenderSettings {
         width: 100_000,
         height: 100_000,
-        threads: 100_000,
         tile_size: 0,
         method: gi_studio::render::Method::Photon(gi_studio::render::PhotonSettings {
             k_nearest: u32::MAX,
@@ -309,17 +308,19 @@ fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
         exposures: vec![f32::NAN, 1.0],
         show_plots: false,
         recent: Vec::new(),
+        reference_threads: 100_000,
     };
     storage.set_string("studio", ron::to_string(&saved).unwrap());
     let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &StudioArgs::default());
     assert_eq!(app.panes().count(), 2);
     let first = app.panes().list()[0].settings();
     assert!(first.problems().is_empty(), "{:?}", first.problems());
-    assert!(first.width <= 4096 && first.threads == 0 && first.tile_size == 32);
+    assert!(first.width <= 4096 && first.tile_size == 32);
+    assert_eq!(app.references().threads(), 1);
     assert_eq!(*app.panes().list()[1].settings(), fine);
     assert_eq!((app.panes().list()[0].exposure(), app.panes().list()[1].exposure()), (0.0, 1.0));
     assert!(
-        app.messages().status.contains("pane 1's saved size") && app.messages().status.contains("exposure"),
+        ["pane 1's saved size", "exposure", "reference threads"].iter().all(|s| app.messages().status.contains(s)),
         "{}",
         app.messages().status
     );

@@ -1,12 +1,15 @@
 //! Error against time: one point per pass, and what the benchmark reads off
 //! the curve (error at a time, time to reach an error, log–log slope).
 
+use super::metrics::ErrorEstimate;
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ConvergencePoint {
     pub seconds: f64,
     pub samples_per_pixel: u32,
     pub rays: u64,
-    pub rel_mse: f64,
+    /// relMSE against the reference, its noise taken out.
+    pub error: ErrorEstimate,
     /// FLIP is costlier: measured at roughly log-spaced times only.
     pub flip: Option<f64>,
 }
@@ -23,12 +26,12 @@ impl ConvergenceLog {
 
     /// relMSE of the last point at or before `seconds`.
     pub fn error_at(&self, seconds: f64) -> Option<f64> {
-        self.points.iter().take_while(|p| p.seconds <= seconds).last().map(|p| p.rel_mse)
+        self.points.iter().take_while(|p| p.seconds <= seconds).last().map(|p| p.error.rel_mse)
     }
 
     /// The first time relMSE fell to `threshold` or below.
     pub fn time_to_reach(&self, threshold: f64) -> Option<f64> {
-        self.points.iter().find(|p| p.rel_mse <= threshold).map(|p| p.seconds)
+        self.points.iter().find(|p| p.error.rel_mse <= threshold).map(|p| p.seconds)
     }
 
     /// Least-squares slope of log error against log time over the second
@@ -38,8 +41,8 @@ impl ConvergenceLog {
         let usable: Vec<(f64, f64)> = self
             .points
             .iter()
-            .filter(|p| p.seconds > 0.0 && p.rel_mse > 0.0)
-            .map(|p| (p.seconds.ln(), p.rel_mse.ln()))
+            .filter(|p| p.seconds > 0.0 && p.error.rel_mse > 0.0)
+            .map(|p| (p.seconds.ln(), p.error.rel_mse.ln()))
             .collect();
         let end = usable.last()?.0;
         let start = usable.first()?.0;
@@ -64,7 +67,8 @@ mod tests {
         let mut log = ConvergenceLog::default();
         for i in 1..=64 {
             let seconds = i as f64 * 0.25;
-            log.push(ConvergencePoint { seconds, samples_per_pixel: i, rays: 0, rel_mse: 0.1 / seconds, flip: None });
+            let error = ErrorEstimate { rel_mse: 0.1 / seconds, standard_error: 0.0, noise_floor: None };
+            log.push(ConvergencePoint { seconds, samples_per_pixel: i, rays: 0, error, flip: None });
         }
         assert!((log.loglog_slope().unwrap() + 1.0).abs() < 1e-9);
         assert_eq!(log.error_at(1.0), Some(0.1));

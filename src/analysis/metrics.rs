@@ -2,6 +2,8 @@
 //! (with optional outlier rejection), SSIM on tone-mapped luminance, and
 //! per-pixel relative error in false colour.
 
+use super::reference::Reference;
+use crate::render::film::{TermSums, REL_MSE_EPSILON};
 use crate::render::image::{srgb_encode, tonemap_srgb8, LinearImage};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -50,8 +52,48 @@ pub struct RelMseOptions {
 
 impl Default for RelMseOptions {
     fn default() -> Self {
-        Self { epsilon: 1e-2, reject_top_fraction: 0.0 }
+        Self { epsilon: REL_MSE_EPSILON, reject_top_fraction: 0.0 }
     }
+}
+
+/// relMSE against a reference, with what the reference's own noise makes
+/// of it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ErrorEstimate {
+    /// The test image's relMSE against the image the reference converges
+    /// to: the raw relMSE less the reference's noise (`noise_floor`).
+    pub rel_mse: f64,
+    /// Its standard error over the pixels.
+    pub standard_error: f64,
+    /// What the reference's noise adds to the raw relMSE (the raw curve
+    /// flattens there; that is the reference, not bias). None where the
+    /// reference carries no variance, and then nothing is subtracted.
+    pub noise_floor: Option<f64>,
+}
+
+/// relMSE of `test` against `reference`, corrected for the reference's
+/// noise: for independent estimates E[(t − r)²] = E[(t − μ)²] + Var(r), so
+/// each pixel's Var(r)/(r² + ε) is taken off its term.
+pub fn rel_mse_against(test: &LinearImage, reference: &Reference) -> Result<ErrorEstimate, MetricError> {
+    let image = &reference.image;
+    check(test, image)?;
+    let variance = reference.variance.as_ref().filter(|v| (v.width, v.height) == (image.width, image.height));
+    let (mut terms, mut floor) = (TermSums::default(), TermSums::default());
+    for (i, (t, r)) in test.pixels.iter().zip(&image.pixels).enumerate() {
+        for c in 0..3 {
+            let (t, r) = (t[c] as f64, r[c] as f64);
+            let scale = 1.0 / (r * r + REL_MSE_EPSILON);
+            let noise = variance.map_or(0.0, |v| v.pixels[i][c] as f64 * scale);
+            terms.push((t - r).powi(2) * scale - noise);
+            floor.push(noise);
+        }
+    }
+    let estimate = terms.estimate().ok_or(MetricError::Empty)?;
+    Ok(ErrorEstimate {
+        rel_mse: estimate.rel_mse,
+        standard_error: estimate.standard_error,
+        noise_floor: variance.and(floor.estimate()).map(|f| f.rel_mse),
+    })
 }
 
 /// Per-pixel relative squared error, averaged over channels.

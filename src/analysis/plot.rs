@@ -18,12 +18,18 @@ fn register_font() {
     });
 }
 
-/// Draw `series` (name, log) to `path`.
-pub fn plot_error_against_time(title: &str, series: &[(String, ConvergenceLog)], path: &Path) -> Result<(), String> {
+/// Draw `series` (name, log) to `path`, and the reference's noise floor
+/// (where a curve that flattens has met the reference, not bias).
+pub fn plot_error_against_time(
+    title: &str,
+    series: &[(String, ConvergenceLog)],
+    noise_floor: Option<f64>,
+    path: &Path,
+) -> Result<(), String> {
     register_font();
     let points: Vec<(f64, f64)> = series
         .iter()
-        .flat_map(|(_, log)| log.points.iter().map(|p| (p.seconds, p.rel_mse)))
+        .flat_map(|(_, log)| log.points.iter().map(|p| (p.seconds, p.error.rel_mse)))
         .filter(|(t, e)| *t > 0.0 && *e > 0.0)
         .collect();
     if points.is_empty() {
@@ -31,6 +37,8 @@ pub fn plot_error_against_time(title: &str, series: &[(String, ConvergenceLog)],
     }
     let (t0, t1) = points.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
     let (e0, e1) = points.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    let floor = noise_floor.filter(|f| *f > 0.0);
+    let e0 = floor.map_or(e0, |f| e0.min(f));
     let (width, height) = (900u32, 600u32);
     let mut rgb = vec![0u8; (width * height * 3) as usize];
     {
@@ -56,14 +64,26 @@ pub fn plot_error_against_time(title: &str, series: &[(String, ConvergenceLog)],
             let line: Vec<(f64, f64)> = log
                 .points
                 .iter()
-                .filter(|p| p.seconds > 0.0 && p.rel_mse > 0.0)
-                .map(|p| (p.seconds, p.rel_mse))
+                .filter(|p| p.seconds > 0.0 && p.error.rel_mse > 0.0)
+                .map(|p| (p.seconds, p.error.rel_mse))
                 .collect();
             chart
                 .draw_series(LineSeries::new(line, colour.stroke_width(2)))
                 .map_err(|e| e.to_string())?
                 .label(name.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
+        }
+        if let Some(floor) = floor {
+            let grey = RGBColor(120, 120, 120);
+            let dashes = (0..40).map(|k| {
+                let at = |j: f64| (t0 * 0.8) * ((t1 * 1.25) / (t0 * 0.8)).powf(j / 80.0);
+                PathElement::new(vec![(at(2.0 * k as f64), floor), (at(2.0 * k as f64 + 1.0), floor)], grey)
+            });
+            chart
+                .draw_series(dashes)
+                .map_err(|e| e.to_string())?
+                .label("the reference's own noise")
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], grey));
         }
         chart
             .configure_series_labels()

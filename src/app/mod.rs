@@ -18,6 +18,7 @@ mod menu;
 mod pane;
 mod panes;
 mod plots;
+mod references;
 mod status;
 mod storage;
 mod studio;

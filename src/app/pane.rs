@@ -8,12 +8,16 @@ use std::time::Duration;
 
 use eframe::egui;
 
-use crate::analysis::metrics::{rel_mse, RelMseOptions};
+use crate::analysis::metrics::{rel_mse_against, ErrorEstimate};
+use crate::analysis::reference::Reference;
 use crate::limits;
+use crate::render::film::NoiseEstimate;
 use crate::render::image::tonemap_srgb8;
 use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::world::camera::TileRect;
-use crate::render::{Algorithm, LinearImage, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
+use crate::render::{
+    Algorithm, LinearImage, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers,
+};
 use crate::scene::ValidScene;
 
 /// One point of a pane's convergence history.
@@ -23,10 +27,36 @@ pub struct PassRecord {
     pub seconds: f64,
     pub pass_seconds: f64,
     pub samples_per_second: f64,
-    /// relMSE against the reference, when there is one.
-    pub error: Option<f64>,
+    /// How wrong the image was after the pass, if that can be said.
+    pub error: Option<PaneError>,
     /// SPPM's mean gather radius after the pass.
     pub sppm_radius: Option<f32>,
+}
+
+/// How wrong a pane's image is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PaneError {
+    /// relMSE against the reference, its noise taken out.
+    Measured(ErrorEstimate),
+    /// relMSE estimated from the image's own noise (an unbiased method,
+    /// while there is no reference to compare with).
+    Estimated(NoiseEstimate),
+}
+
+impl PaneError {
+    pub fn rel_mse(&self) -> f64 {
+        match self {
+            PaneError::Measured(e) => e.rel_mse,
+            PaneError::Estimated(e) => e.rel_mse,
+        }
+    }
+
+    pub fn standard_error(&self) -> f64 {
+        match self {
+            PaneError::Measured(e) => e.standard_error,
+            PaneError::Estimated(e) => e.standard_error,
+        }
+    }
 }
 
 /// What a pane knows about its current job, fed only by engine events.
@@ -60,7 +90,7 @@ impl PaneState {
     /// Apply one engine event. Events of any other generation (a job that
     /// was restarted) are dropped: their tiles never reach the texture.
     /// Returns whether anything changed.
-    pub fn apply(&mut self, event: RenderEvent, reference: Option<&LinearImage>) -> bool {
+    pub fn apply(&mut self, event: RenderEvent, reference: Option<&Reference>) -> bool {
         if event.generation() != self.generation {
             return false;
         }
@@ -83,10 +113,11 @@ impl PaneState {
             }
             RenderEvent::PhotonMaps { stats, .. } => self.maps = Some(stats),
             RenderEvent::PassFinished { stats, .. } => {
-                let error = reference.and_then(|r| {
-                    let comparable = self.image.at_size(r.width, r.height)?;
-                    rel_mse(&comparable, r, RelMseOptions::default()).ok()
+                let measured = reference.and_then(|r| {
+                    let comparable = self.image.at_size(r.image.width, r.image.height)?;
+                    rel_mse_against(&comparable, r).ok()
                 });
+                let error = measured.map(PaneError::Measured).or(stats.noise.map(PaneError::Estimated));
                 self.history.push(PassRecord {
                     passes: stats.passes,
                     seconds: stats.elapsed.as_secs_f64(),
@@ -110,7 +141,7 @@ impl PaneState {
         self.stats.map_or(0, |s| s.passes)
     }
 
-    pub fn latest_error(&self) -> Option<f64> {
+    pub fn latest_error(&self) -> Option<PaneError> {
         self.history.last().and_then(|r| r.error)
     }
 }
@@ -119,19 +150,26 @@ pub struct Pane {
     settings: RenderSettings,
     exposure: f32,
     state: PaneState,
-    /// None when the OS refused the worker thread (said in `state.failed`).
+    /// None when the OS refused its thread (said in `state.failed`).
     session: Option<RenderSession>,
     texture: Option<egui::TextureHandle>,
 }
 
 impl Pane {
-    pub fn new(ctx: &egui::Context, settings: RenderSettings, exposure: f32) -> Self {
+    /// A pane rendering on `workers` (shared with the other panes; None if
+    /// the OS refused them, which the pane then says).
+    pub fn new(ctx: &egui::Context, workers: Option<&Workers>, settings: RenderSettings, exposure: f32) -> Self {
         let repaint = ctx.clone();
         let mut state = PaneState::new(0, settings.width, settings.height);
-        let session = match RenderSession::new(Some(Arc::new(move || repaint.request_repaint()))) {
-            Ok(session) => Some(session),
-            Err(e) => {
-                state.failed = Some(format!("could not start this pane's render worker: {e}"));
+        let notify: crate::render::engine::Notify = Arc::new(move || repaint.request_repaint());
+        let session = match workers.map(|w| RenderSession::new(w, Some(notify))) {
+            Some(Ok(session)) => Some(session),
+            Some(Err(e)) => {
+                state.failed = Some(format!("could not start this pane's render thread: {e}"));
+                None
+            }
+            None => {
+                state.failed = Some("the render threads could not start".into());
                 None
             }
         };
@@ -173,7 +211,7 @@ impl Pane {
     }
 
     /// Take every waiting event without blocking.
-    pub fn poll(&mut self, reference: Option<&LinearImage>) -> bool {
+    pub fn poll(&mut self, reference: Option<&Reference>) -> bool {
         let Some(session) = &self.session else { return false };
         let mut changed = false;
         loop {
@@ -222,7 +260,9 @@ impl Pane {
         self.texture = None;
     }
 
-    /// "Path tracing · 64 spp · 3.2 s · 2.1 M samples/s · relMSE 1.3e-3"
+    /// "Path tracing · 64 spp · 3.2 s · 2.1 M samples/s · relMSE 1.3e-3 ±2e-5";
+    /// "≈1.3e-3 (own noise)" while there is no reference; "needs a
+    /// reference" for a biased method without one.
     pub fn label(&self) -> String {
         let mut label = self.algorithm().label().to_owned();
         if let Some(stats) = &self.state.stats {
@@ -234,7 +274,9 @@ impl Pane {
             );
         }
         label += &match self.state.latest_error() {
-            Some(e) => format!(" · relMSE {e:.2e}"),
+            Some(PaneError::Measured(e)) => format!(" · relMSE {:.2e} ±{:.0e}", e.rel_mse, e.standard_error),
+            Some(PaneError::Estimated(e)) => format!(" · relMSE ≈{:.2e} (own noise)", e.rel_mse),
+            None if !self.algorithm().is_unbiased() => " · relMSE — (needs a reference)".to_owned(),
             None => " · relMSE —".to_owned(),
         };
         label
@@ -325,6 +367,7 @@ mod tests {
             rect: TileRect { x: 0, y: 0, width: 2, height: 2 },
             pixels: vec![[value; 3]; 4],
             preview: false,
+            variance: None,
         })
     }
 

@@ -3,7 +3,6 @@
 //! together when the scene changes, and measured against the scene's
 //! reference.
 
-use std::path::PathBuf;
 use std::sync::Arc;
 
 use eframe::egui;
@@ -12,8 +11,9 @@ use super::document::Document;
 use super::inspector::Selection;
 use super::pane::Pane;
 use super::viewport::viewport_ui;
-use crate::render::{Algorithm, LinearImage, RenderSettings};
-use crate::scene::{presets, Scene, SceneSettings, ValidScene};
+use crate::analysis::reference::Reference;
+use crate::render::{Algorithm, RenderSettings, Workers};
+use crate::scene::{SceneSettings, ValidScene};
 
 pub struct Panes {
     list: Vec<Pane>,
@@ -21,7 +21,8 @@ pub struct Panes {
     /// area (screen points).
     rects: Vec<egui::Rect>,
     area: egui::Rect,
-    reference: Option<LinearImage>,
+    /// The render threads every pane shares (None: the OS refused them).
+    workers: Option<Workers>,
     ctx: egui::Context,
 }
 
@@ -42,8 +43,9 @@ pub fn pane_count(wanted: usize) -> usize {
 }
 
 impl Panes {
-    pub fn new(ctx: &egui::Context) -> Self {
-        Self { list: Vec::new(), rects: Vec::new(), area: egui::Rect::NOTHING, reference: None, ctx: ctx.clone() }
+    /// Panes that share `workers`.
+    pub fn new(ctx: &egui::Context, workers: Option<Workers>) -> Self {
+        Self { list: Vec::new(), rects: Vec::new(), area: egui::Rect::NOTHING, workers, ctx: ctx.clone() }
     }
 
     /// A pane's settings for `algorithm` among `count` panes of a scene.
@@ -70,7 +72,8 @@ impl Panes {
                     .cloned()
                     .flatten()
                     .unwrap_or_else(|| Self::default_settings(algorithms[i], count, scene));
-                Pane::new(&self.ctx, settings, exposures.get(i).copied().unwrap_or(scene.exposure))
+                let exposure = exposures.get(i).copied().unwrap_or(scene.exposure);
+                Pane::new(&self.ctx, self.workers.as_ref(), settings, exposure)
             })
             .collect();
         self.rects.clear();
@@ -120,26 +123,11 @@ impl Panes {
         self.list.iter_mut().for_each(Pane::pause);
     }
 
-    pub fn reference(&self) -> Option<&LinearImage> {
-        self.reference.as_ref()
-    }
-
-    /// The stored reference of the preset `scene` is, if it is one: the
-    /// panes' error is measured against it where their size matches.
-    pub fn load_reference_for(&mut self, scene: &Scene) {
-        let name = presets::names().find(|n| presets::preset(n).and_then(Result::ok).is_some_and(|s| *s == *scene));
-        let path = |name: &str| PathBuf::from(format!("assets/references/{name}.exr"));
-        self.reference = name.and_then(|name| LinearImage::load(&path(name)).ok());
-    }
-
-    /// Take every pane's waiting events, measuring against the reference
-    /// where the pane's size matches it.
-    pub fn poll(&mut self) {
-        let reference = &self.reference;
+    /// Take every pane's waiting events, measuring against `reference`
+    /// where a pane's size divides into it.
+    pub fn poll(&mut self, reference: Option<&Reference>) {
         for pane in &mut self.list {
-            let settings = pane.settings();
-            let matching = reference.as_ref().filter(|r| r.width == settings.width && r.height == settings.height);
-            pane.poll(matching);
+            pane.poll(reference);
         }
     }
 
@@ -149,8 +137,9 @@ impl Panes {
     }
 
     /// The grid of panes, each with its header (algorithm, settings,
-    /// restart) and viewport.
-    pub fn panes_ui(&mut self, ui: &mut egui::Ui, document: &mut Document, selection: &mut Selection) {
+    /// restart, use as reference) and viewport. Returns the pane whose
+    /// image the user made the reference.
+    pub fn panes_ui(&mut self, ui: &mut egui::Ui, document: &mut Document, selection: &mut Selection) -> Option<usize> {
         self.area = ui.max_rect();
         let count = self.list.len();
         let columns = if count == 1 { 1 } else { 2 };
@@ -158,13 +147,19 @@ impl Panes {
         let cell = egui::vec2(ui.available_width() / columns as f32, ui.available_height() / rows as f32);
         let origin = ui.min_rect().min;
         self.rects.resize(count, egui::Rect::NOTHING);
+        let mut promoted = None;
         for index in 0..count {
             let (row, column) = (index / columns, index % columns);
             let min = origin + egui::vec2(column as f32 * cell.x, row as f32 * cell.y);
             let rect = egui::Rect::from_min_size(min, cell).shrink(3.0);
             let mut child = ui.new_child(egui::UiBuilder::new().max_rect(rect).id_salt(("pane", index)));
-            self.rects[index] = self.pane_ui(&mut child, index, document, selection);
+            let (drawn, promote) = self.pane_ui(&mut child, index, document, selection);
+            self.rects[index] = drawn;
+            if promote {
+                promoted = Some(index);
+            }
         }
+        promoted
     }
 
     fn pane_ui(
@@ -173,20 +168,22 @@ impl Panes {
         index: usize,
         document: &mut Document,
         selection: &mut Selection,
-    ) -> egui::Rect {
+    ) -> (egui::Rect, bool) {
         let pane = &mut self.list[index];
-        let mut restart = false;
+        let (mut restart, mut promote) = (false, false);
         ui.horizontal(|ui| {
             restart |= pane.algorithm_ui(ui, index);
             ui.menu_button("Settings", |ui| restart |= pane.settings_ui(ui));
             restart |= ui.small_button("Restart").on_hover_text("Restart this pane").clicked();
+            let hint = "Measure every pane against this pane's image from now on";
+            promote |= ui.small_button("Use as reference").on_hover_text(hint).clicked();
         });
         if restart {
             if let Some(scene) = document.valid() {
                 pane.restart(scene.clone());
             }
         }
-        viewport_ui(ui, pane, document, selection).rect
+        (viewport_ui(ui, pane, document, selection).rect, promote)
     }
 
     /// The generation each pane is rendering (tests watch restarts with it).

@@ -2,9 +2,9 @@
 //! against time on log–log axes, and the photon maps' statistics.
 
 use eframe::egui;
-use egui_plot::{Bar, BarChart, Legend, Line, Plot};
+use egui_plot::{Bar, BarChart, HLine, Legend, Line, LineStyle, Plot};
 
-use super::pane::Pane;
+use super::pane::{Pane, PaneError};
 use crate::render::integrators::photon_map::maps::RADIUS_BINS;
 
 pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
@@ -27,16 +27,32 @@ pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
                 plot.line(Line::new(series_name(i, pane), points));
             }
         });
-        columns[2].label("log₁₀ relMSE against log₁₀ seconds");
+        columns[2].label("log₁₀ relMSE against log₁₀ seconds (dashed: estimated from own noise)");
         Plot::new("error").legend(Legend::default()).height(height).show(&mut columns[2], |plot| {
+            let mut floor = None;
             for (i, pane) in panes.iter().enumerate() {
-                let points: Vec<[f64; 2]> = pane
-                    .state()
-                    .history
-                    .iter()
-                    .filter_map(|r| r.error.filter(|e| *e > 0.0).map(|e| [r.seconds.max(1e-6).log10(), e.log10()]))
-                    .collect();
-                plot.line(Line::new(series_name(i, pane), points));
+                let (mut line, mut low, mut high, mut estimated) = (Vec::new(), Vec::new(), Vec::new(), false);
+                for record in &pane.state().history {
+                    let Some(error) = record.error.filter(|e| e.rel_mse() > 0.0) else { continue };
+                    let t = record.seconds.max(1e-6).log10();
+                    line.push([t, error.rel_mse().log10()]);
+                    // ±1 standard error, where it stays above zero
+                    let spread = error.standard_error();
+                    low.push([t, (error.rel_mse() - spread).max(error.rel_mse() * 0.1).log10()]);
+                    high.push([t, (error.rel_mse() + spread).log10()]);
+                    match error {
+                        PaneError::Measured(e) => floor = e.noise_floor.or(floor),
+                        PaneError::Estimated(_) => estimated = true,
+                    }
+                }
+                let name = series_name(i, pane);
+                let style = if estimated { LineStyle::dashed_loose() } else { LineStyle::Solid };
+                plot.line(Line::new(name.clone(), line).style(style));
+                plot.line(Line::new(name.clone(), low).width(0.5));
+                plot.line(Line::new(name, high).width(0.5));
+            }
+            if let Some(floor) = floor.filter(|f| *f > 0.0) {
+                plot.hline(HLine::new("reference's own noise", floor.log10()).style(LineStyle::dotted_dense()));
             }
         });
         photon_ui(&mut columns[3], panes, height);

@@ -21,14 +21,18 @@ use super::keys::{input_commands, WindowState};
 use super::menu::{menu_bar_ui, MenuView};
 use super::panes::{pane_count, Panes};
 use super::plots::plots_ui;
+use super::references::References;
 use super::status::{FrameClock, Messages};
 use super::storage::{autosave_offer, read_state, remember, write_state, Autosave, Persisted, StateFile, StateKeeper};
 use super::StudioArgs;
+use crate::analysis::reference::ReferenceCache;
+use crate::render::Workers;
 use crate::scene::{load_scene, presets, Scene};
 
 pub struct StudioApp {
     document: Document,
     panes: Panes,
+    references: References,
     selection: Selection,
     dialogs: Dialogs,
     capture: Capture,
@@ -52,8 +56,14 @@ impl StudioApp {
         let capture_only = args.screenshot.is_some();
         let autosave_offer = autosave_offer(autosaved, document.scene()).filter(|_| !capture_only);
         let count = pane_count(args.panes.unwrap_or(restored.panes.len().max(1)));
+        // One pool of every core for all the panes, below the UI's priority
+        let (workers, workers_error) = match Workers::new(0) {
+            Ok(workers) => (Some(workers), None),
+            Err(e) => (None, Some(format!("could not start the render threads: {e}"))),
+        };
         let mut app = Self {
-            panes: Panes::new(ctx),
+            panes: Panes::new(ctx, workers),
+            references: References::new(ctx, restored.reference_threads, ReferenceCache::open_default()),
             document,
             selection: Selection::Camera,
             dialogs: Dialogs::new(autosave_offer),
@@ -64,7 +74,7 @@ impl StudioApp {
             difference: Difference::default(),
             shown: Shown { plots: restored.show_plots, ..Shown::default() },
             recent: restored.recent,
-            messages: Messages { error, status: restored.notices.join("; ") },
+            messages: Messages { error: error.or(workers_error), status: restored.notices.join("; ") },
             quit_confirmed: false,
             state: StateKeeper::new(capture_only),
             clock: FrameClock::default(),
@@ -95,6 +105,15 @@ impl StudioApp {
 
     pub fn panes_mut(&mut self) -> &mut Panes {
         &mut self.panes
+    }
+
+    /// The scene's reference, wherever it comes from.
+    pub fn references(&self) -> &References {
+        &self.references
+    }
+
+    pub fn references_mut(&mut self) -> &mut References {
+        &mut self.references
     }
 
     pub fn selection(&self) -> Selection {
@@ -137,8 +156,15 @@ impl StudioApp {
         self.document.check();
         if let Some(scene) = self.document.valid().cloned() {
             self.panes.restart_all(&scene);
+            self.references.follow(&scene);
         }
-        self.panes.load_reference_for(self.document.scene());
+    }
+
+    /// Make pane `index`'s image the reference.
+    pub fn promote_pane(&mut self, index: usize) {
+        let Some(pane) = self.panes.list().get(index) else { return };
+        let promoted = self.references.promote(index, pane.algorithm(), &pane.state().image);
+        self.messages.report(promoted, || format!("Pane {}'s image is the reference now", index + 1));
     }
 
     /// Open a scene file; a broken one leaves the scene being edited as it was.
@@ -279,7 +305,10 @@ impl StudioApp {
     pub fn show(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         self.clock.tick();
-        self.panes.poll();
+        if let Some(message) = self.references.poll() {
+            self.messages.fail(message);
+        }
+        self.panes.poll(self.references.reference());
         let mut commands = Vec::new();
         let window = input_commands(&ctx, &mut commands);
         self.window_events(&ctx, window);
@@ -296,6 +325,7 @@ impl StudioApp {
             menu_bar_ui(ui, &view, &mut commands);
         });
         self.messages.status_ui(ui);
+        egui::Panel::bottom("reference").show(ui, |ui| self.references.reference_ui(ui));
         egui::Panel::left("inspector").resizable(true).default_size(330.0).show(ui, |ui| {
             let problems = self.document.problems().to_vec();
             if inspector_ui(ui, self.document.scene_mut(), &mut self.selection, &problems) {
@@ -308,20 +338,25 @@ impl StudioApp {
                 .default_size(200.0)
                 .show(ui, |ui| plots_ui(ui, self.panes.list()));
         }
-        egui::CentralPanel::default().show(ui, |ui| self.panes.panes_ui(ui, &mut self.document, &mut self.selection));
+        let promoted = egui::CentralPanel::default()
+            .show(ui, |ui| self.panes.panes_ui(ui, &mut self.document, &mut self.selection))
+            .inner;
         self.dialogs.dialogs_ui(&ctx, self.document.path(), &mut commands);
         if self.shown.difference {
-            self.difference.difference_ui(&ctx, &self.panes);
+            self.difference.difference_ui(&ctx, &self.panes, self.references.reference());
         }
         for command in commands {
             self.apply(command);
+        }
+        if let Some(index) = promoted {
+            self.promote_pane(index);
         }
 
         self.document.commit(ctx.input(|i| i.pointer.any_down()));
         if let Some(scene) = self.document.check() {
             if !self.paused {
                 self.panes.restart_all(&scene);
-                self.panes.load_reference_for(self.document.scene());
+                self.references.follow(&scene);
             }
         }
         self.capture_step(&ctx);
@@ -380,7 +415,7 @@ impl eframe::App for StudioApp {
                 Autosave::Keep
             }
         };
-        let persisted = Persisted::of(&self.panes, self.shown.plots, &self.recent);
+        let persisted = Persisted::of(&self.panes, self.shown.plots, &self.recent, self.references.threads());
         if let Err(e) = write_state(storage, &persisted, autosave) {
             self.messages.fail(e);
         }

@@ -13,18 +13,23 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::outputs::Outputs;
-use super::reference::stem;
+use super::reference::{render_reference, stem};
 use crate::analysis::convergence::{ConvergenceLog, ConvergencePoint};
-use crate::analysis::metrics::{flip, rel_mse, RelMseOptions};
+use crate::analysis::metrics::{flip, rel_mse_against};
 use crate::analysis::plot::plot_error_against_time;
+use crate::analysis::reference::{
+    find, reference_method, reference_settings, reference_size, Reference, ReferenceCache,
+};
 use crate::fileio::{self, SIGNATURE};
 use crate::limits;
-use crate::render::{Algorithm, LinearImage, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
-use crate::scene::{load_scene, ValidScene};
+use crate::render::{
+    Algorithm, LinearImage, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers,
+};
+use crate::scene::{load_scene, presets, ValidScene};
 
 #[derive(Debug, Args)]
 pub struct BenchArgs {
-    /// Scene files; every preset with a reference in assets/references if none.
+    /// Scene files; every preset if none.
     pub scenes: Vec<PathBuf>,
     /// Seconds each algorithm renders each scene.
     #[arg(long, default_value_t = 10.0, value_parser = |s: &str| limits::SECONDS.parse(s))]
@@ -32,9 +37,14 @@ pub struct BenchArgs {
     /// Comma-separated algorithms.
     #[arg(long, value_delimiter = ',', default_value = "whitted,path,photon,sppm")]
     pub algos: Vec<Algorithm>,
-    /// Folder of references named <scene>.exr.
-    #[arg(long, default_value = "assets/references")]
-    pub references: PathBuf,
+    /// A folder of references named <scene>.exr to use instead of the
+    /// built-in ones and the reference cache.
+    #[arg(long)]
+    pub references: Option<PathBuf>,
+    /// For a scene without a reference, render one for up to this many
+    /// seconds first (and keep it in the cache); 0: refuse such a scene.
+    #[arg(long, default_value_t = 120.0, value_parser = |s: &str| limits::SECONDS_OR_NONE.parse(s))]
+    pub reference_budget: f64,
     /// Where the CSV, plots and final images go.
     #[arg(long, default_value = "bench-results")]
     pub out: PathBuf,
@@ -48,7 +58,7 @@ pub struct BenchArgs {
 }
 
 /// The CSV's first line, which also marks the file as this program's.
-const CSV_HEADER: &str = "scene,algorithm,seconds,spp,rays,relmse,flip\n";
+const CSV_HEADER: &str = "scene,algorithm,seconds,spp,rays,relmse,relmse_se,flip\n";
 
 /// One algorithm on one scene.
 pub struct Run {
@@ -58,15 +68,17 @@ pub struct Run {
     pub image: LinearImage,
 }
 
-/// Render `scene` with `settings` until its budget, logging error against
-/// `reference` after every pass (FLIP at roughly log-spaced times).
+/// Render `scene` with `settings` on `workers` until its budget, logging
+/// error against `reference` after every pass (FLIP at roughly log-spaced
+/// times).
 pub fn measure(
+    workers: &Workers,
     scene: &Arc<ValidScene>,
     settings: RenderSettings,
-    reference: &LinearImage,
+    reference: &Reference,
     progress: Option<&ProgressBar>,
 ) -> Result<Run> {
-    let session = RenderSession::new(None).context("could not start the render worker")?;
+    let session = RenderSession::new(workers, None).context("could not start the render worker")?;
     let (width, height) = (settings.width, settings.height);
     let algorithm = settings.algorithm();
     let generation = session.start(RenderJob::new(scene.clone(), settings));
@@ -96,8 +108,8 @@ pub fn measure(
                     seconds,
                     samples_per_pixel: stats.passes,
                     rays: stats.rays,
-                    rel_mse: rel_mse(&image, reference, RelMseOptions::default())?,
-                    flip: if flip_now { Some(flip(&image, reference, 0.0)?) } else { None },
+                    error: rel_mse_against(&image, reference)?,
+                    flip: if flip_now { Some(flip(&image, &reference.image, 0.0)?) } else { None },
                 });
                 if let Some(bar) = progress {
                     bar.set_position((seconds * 10.0) as u64);
@@ -106,7 +118,7 @@ pub fn measure(
             RenderEvent::Finished { image: last, stats, .. } => {
                 let image = Arc::try_unwrap(last).unwrap_or_else(|shared| (*shared).clone());
                 if let Some(point) = log.points.last_mut() {
-                    point.flip = Some(flip(&image, reference, 0.0)?);
+                    point.flip = Some(flip(&image, &reference.image, 0.0)?);
                 }
                 return Ok(Run { algorithm, log, stats, image });
             }
@@ -124,55 +136,97 @@ fn format_error(e: Option<f64>) -> String {
     e.map_or("—".into(), |e| format!("{e:.2e}"))
 }
 
-pub fn run(args: &BenchArgs) -> Result<()> {
-    let scenes: Vec<PathBuf> = if args.scenes.is_empty() {
-        crate::scene::presets::names()
-            .map(|n| PathBuf::from(format!("assets/scenes/{n}.ron")))
-            .filter(|p| args.references.join(format!("{}.exr", stem(p))).exists())
-            .collect()
-    } else {
-        args.scenes.clone()
-    };
-    if scenes.is_empty() {
-        bail!("no scenes with references in {}", args.references.display());
+/// A scene to measure: its name, the scene, where it came from.
+struct Subject {
+    name: String,
+    scene: Arc<ValidScene>,
+    file: Option<PathBuf>,
+}
+
+/// The reference `subject` is measured against, and where it came from:
+/// `--references`, the built-in ones and the cache, or rendered now.
+fn reference_for(args: &BenchArgs, subject: &Subject, workers: &Workers) -> Result<(Reference, String)> {
+    let scene = &subject.scene;
+    if let Some(dir) = &args.references {
+        let path = dir.join(format!("{}.exr", subject.name));
+        let reference = Reference::load(&path).with_context(|| format!("the reference for {}", subject.name))?;
+        return Ok((reference, path.display().to_string()));
     }
-    // Every scene and reference read, every output claimed, before any work
+    let (width, height) = reference_size(scene);
+    let cache = ReferenceCache::open_default();
+    if let Some(reference) = find(scene, width, height, cache.as_ref()) {
+        let made = format!("{}, {} spp", reference.info.algorithm, reference.info.samples_per_pixel);
+        return Ok((reference, made));
+    }
+    let method = reference_method(scene);
+    let file = subject.file.as_ref().map_or_else(|| subject.name.clone(), |f| f.display().to_string());
+    if args.reference_budget <= 0.0 {
+        bail!(
+            "no reference for {file}: make one with `gi-studio reference {file}`, or give --reference-budget SECONDS"
+        );
+    }
+    println!(
+        "{}: no reference yet; rendering one for up to {} s ({})",
+        subject.name, args.reference_budget, method.reason
+    );
+    let mut settings = reference_settings(method.algorithm, width, height);
+    settings.time_limit = Some(args.reference_budget);
+    let (reference, stats) = render_reference(workers, scene, &file, &settings)?;
+    let kept = match &cache {
+        Some(cache) => cache.put(&reference).map(|p| format!(", kept in {}", p.display()))?,
+        None => String::new(),
+    };
+    let made = format!("{}, {} spp in {:.0} s{kept}", method.algorithm, stats.passes, stats.elapsed.as_secs_f64());
+    Ok((reference, made))
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let subjects: Vec<Subject> = if args.scenes.is_empty() {
+        (presets::names())
+            .map(|name| {
+                let scene = presets::preset(name).context("a preset")??;
+                Ok(Subject { name: name.to_owned(), scene: Arc::new(scene), file: None })
+            })
+            .collect::<Result<_>>()?
+    } else {
+        (args.scenes.iter())
+            .map(|path| Ok(Subject { name: stem(path), scene: Arc::new(load_scene(path)?), file: Some(path.clone()) }))
+            .collect::<Result<_>>()?
+    };
+    // Every scene read and every output claimed before any work
     let mut outputs = Outputs::new(args.force);
-    let mut work = Vec::new();
     let sign: &[&[u8]] = &[SIGNATURE.as_bytes()];
-    for scene_path in &scenes {
-        let name = stem(scene_path);
-        let scene = Arc::new(load_scene(scene_path)?);
-        let reference_path = args.references.join(format!("{name}.exr"));
-        let reference = LinearImage::load(&reference_path).with_context(|| format!("the reference for {name}"))?;
-        outputs.input(scene_path);
-        outputs.input(&reference_path);
-        for algorithm in &args.algos {
-            outputs.claim(&args.out.join(format!("{name}-{algorithm}.png")), sign)?;
+    for subject in &subjects {
+        if let Some(file) = &subject.file {
+            outputs.input(file);
         }
-        outputs.claim(&args.out.join(format!("{name}.png")), sign)?;
-        work.push((name, scene, reference, reference_path));
+        if let Some(dir) = &args.references {
+            outputs.input(&dir.join(format!("{}.exr", subject.name)));
+        }
+        for algorithm in &args.algos {
+            outputs.claim(&args.out.join(format!("{}-{algorithm}.png", subject.name)), sign)?;
+        }
+        outputs.claim(&args.out.join(format!("{}.png", subject.name)), sign)?;
     }
     let csv_path = args.out.join("convergence.csv");
     outputs.claim(&csv_path, &[CSV_HEADER.as_bytes()])?;
+    let workers =
+        Workers::new(args.threads).with_context(|| format!("could not start {} render threads", args.threads))?;
+    let references =
+        (subjects.iter()).map(|subject| reference_for(args, subject, &workers)).collect::<Result<Vec<_>>>()?;
     std::fs::create_dir_all(&args.out).with_context(|| args.out.display().to_string())?;
     let mut csv = String::from(CSV_HEADER);
-    for (name, scene, reference, reference_path) in work {
-        println!(
-            "\n{name} at {}×{} for {} s per algorithm (reference {})",
-            reference.width,
-            reference.height,
-            args.budget,
-            reference_path.display()
-        );
+    for (subject, (reference, made)) in subjects.iter().zip(references) {
+        let name = &subject.name;
+        let (width, height) = (reference.image.width, reference.image.height);
+        println!("\n{name} at {width}×{height} for {} s per algorithm (reference: {made})", args.budget);
         let mut runs = Vec::new();
         for &algorithm in &args.algos {
             let settings = RenderSettings {
-                width: reference.width,
-                height: reference.height,
+                width,
+                height,
                 time_limit: Some(args.budget),
                 samples_per_pixel: None,
-                threads: args.threads,
                 seed: args.seed,
                 ..RenderSettings::for_algorithm(algorithm)
             };
@@ -183,14 +237,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                     .progress_chars("=> "),
             );
             bar.enable_steady_tick(Duration::from_millis(200));
-            let run = measure(&scene, settings, &reference, Some(&bar))?;
+            let run = measure(&workers, &subject.scene, settings, &reference, Some(&bar))?;
             bar.finish_and_clear();
             for p in &run.log.points {
                 let flip = p.flip.map_or(String::new(), |f| format!("{f:.5}"));
                 writeln!(
                     csv,
-                    "{name},{algorithm},{:.4},{},{},{:.6e},{flip}",
-                    p.seconds, p.samples_per_pixel, p.rays, p.rel_mse
+                    "{name},{algorithm},{:.4},{},{},{:.6e},{:.2e},{flip}",
+                    p.seconds, p.samples_per_pixel, p.rays, p.error.rel_mse, p.error.standard_error
                 )?;
             }
             run.image.save(&args.out.join(format!("{name}-{algorithm}.png")), 0.0)?;
@@ -200,7 +254,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let series: Vec<(String, ConvergenceLog)> =
             runs.iter().map(|r| (r.algorithm.label().to_owned(), r.log.clone())).collect();
         let plot_path = args.out.join(format!("{name}.png"));
-        plot_error_against_time(&format!("{name}: relMSE against time"), &series, &plot_path)
+        let floor = runs.first().and_then(|r| r.log.points.last()).and_then(|p| p.error.noise_floor);
+        plot_error_against_time(&format!("{name}: relMSE against time"), &series, floor, &plot_path)
             .map_err(anyhow::Error::msg)?;
         println!("plot → {}", plot_path.display());
     }
@@ -236,7 +291,7 @@ pub fn table(runs: &[Run], budget: f64) -> String {
             run.stats.rays_per_second() / 1e6,
             format_error(log.error_at(1.0)),
             format_error(log.error_at(4.0)),
-            format_error(log.error_at(budget).or(last.map(|p| p.rel_mse))),
+            format_error(log.error_at(budget).or(last.map(|p| p.error.rel_mse))),
             format_time(log.time_to_reach(1e-2)),
             format_time(log.time_to_reach(1e-3)),
             log.loglog_slope().map_or("—".into(), |s| format!("{s:.2}")),

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use indicatif::ProgressBar;
 
@@ -42,11 +42,8 @@ pub fn run(args: &PhotonsArgs) -> Result<()> {
     bar.enable_steady_tick(Duration::from_millis(120));
     let camera = CameraModel::new(&scene.camera, settings.width, settings.height);
     let (world, visible_radius) = World::for_view(&scene, &camera, settings.width, settings.height);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(settings.threads)
-        .build()
-        .with_context(|| format!("could not start {} threads", settings.threads))?;
-    let maps = pool.install(|| PhotonMaps::build(&world, photon, settings.seed, settings.max_depth, visible_radius));
+    let maps = (args.flags.workers()?)
+        .run(|| PhotonMaps::build(&world, photon, settings.seed, settings.max_depth, visible_radius));
     bar.finish_and_clear();
     let key = settings_key(photon, settings.seed, settings.max_depth);
     save_photon_maps(&maps, scene.content_key(), key, &args.output)?;

@@ -15,7 +15,7 @@ use crate::render::image::ImageFormat;
 use crate::render::integrators::photon_map::file::{load_photon_maps, settings_key};
 use crate::render::integrators::photon_map::maps::MapStats;
 use crate::render::integrators::photon_map::PhotonMapStats;
-use crate::render::{Algorithm, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings};
+use crate::render::{Algorithm, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers};
 use crate::scene::{load_scene, Scene};
 
 #[derive(Debug, Args)]
@@ -35,6 +35,8 @@ pub struct RenderArgs {
 /// What a finished render reports besides its image.
 pub struct RenderOutcome {
     pub image: crate::render::LinearImage,
+    /// Each pixel's estimated variance (unbiased methods).
+    pub variance: Option<crate::render::LinearImage>,
     pub stats: PassStats,
     pub maps: Option<PhotonMapStats>,
     /// SPPM's mean gather radius after each pass.
@@ -42,6 +44,11 @@ pub struct RenderOutcome {
 }
 
 impl RenderFlags {
+    /// The render threads `--threads` asks for.
+    pub fn workers(&self) -> Result<Workers> {
+        Workers::new(self.threads).with_context(|| format!("could not start {} render threads", self.threads))
+    }
+
     /// Settings for `scene`, flags overriding the scene's own.
     pub fn settings(&self, scene: &Scene) -> Result<RenderSettings> {
         self.settings_as(scene, self.algorithm)
@@ -59,7 +66,6 @@ impl RenderFlags {
         };
         settings.time_limit = self.time;
         settings.seed = self.seed;
-        settings.threads = self.threads;
         if let Some(depth) = self.max_depth {
             settings.max_depth = depth;
         }
@@ -92,7 +98,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let keys = (job.scene.content_key(), settings_key(photon, settings.seed, settings.max_depth));
         job.photon_maps = Some(Arc::new(load_photon_maps(path, keys.0, keys.1)?));
     }
-    let outcome = render_with_progress(job)?;
+    let outcome = render_with_progress(&args.flags.workers()?, job)?;
     outcome.image.save(&args.output, exposure)?;
     println!("{}", summary_line(&settings, &outcome.stats, &args.output.display().to_string()));
     print_photon_statistics(&outcome);
@@ -150,8 +156,9 @@ pub fn map_line(name: &str, map: &MapStats) -> String {
     )
 }
 
-/// Render on a session, showing passes (or seconds) on a progress bar.
-pub fn render_with_progress(job: RenderJob) -> Result<RenderOutcome> {
+/// Render on a session on `workers`, showing passes (or seconds) on a
+/// progress bar.
+pub fn render_with_progress(workers: &Workers, job: RenderJob) -> Result<RenderOutcome> {
     // Only the final image is written
     let job = RenderJob { stream_tiles: false, ..job };
     let settings = job.settings.clone();
@@ -166,7 +173,7 @@ pub fn render_with_progress(job: RenderJob) -> Result<RenderOutcome> {
     );
     bar.enable_steady_tick(Duration::from_millis(200));
     let timed = settings.time_limit.is_some();
-    let session = RenderSession::new(None).context("could not start the render worker")?;
+    let session = RenderSession::new(workers, None).context("could not start the render worker")?;
     let generation = session.start(job);
     let mut maps = None;
     let mut radii = Vec::new();
@@ -189,9 +196,10 @@ pub fn render_with_progress(job: RenderJob) -> Result<RenderOutcome> {
                 bar.set_position(if timed { (stats.elapsed.as_secs_f64() * 10.0) as u64 } else { stats.passes as u64 });
                 bar.set_message(format!("{} spp, {:.2} M samples/s", stats.passes, stats.samples_per_second() / 1e6));
             }
-            RenderEvent::Finished { image, stats, .. } => {
+            RenderEvent::Finished { image, variance, stats, .. } => {
                 let image = Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone());
-                break RenderOutcome { image, stats, maps, radii };
+                let variance = variance.map(|v| Arc::try_unwrap(v).unwrap_or_else(|shared| (*shared).clone()));
+                break RenderOutcome { image, variance, stats, maps, radii };
             }
             RenderEvent::Failed { message, .. } => bail!("{message}"),
             RenderEvent::Started { .. } | RenderEvent::Tile(_) => {}

@@ -28,19 +28,68 @@ pub fn tile_layout(width: u32, height: u32, tile_size: u32) -> Vec<TileRect> {
     tiles
 }
 
+/// The ε of relMSE's (x − r)²/(r² + ε): it keeps dark pixels from
+/// dominating. The engine's own noise estimate and the metrics share it.
+pub const REL_MSE_EPSILON: f64 = 1e-2;
+
 /// Per-pixel sums of one tile, in f64 so thousands of passes add up exactly
 /// enough.
 #[derive(Clone, Debug)]
 pub struct FilmTile {
     pub rect: TileRect,
     pub sums: Vec<[f64; 3]>,
+    /// The odd passes' sums alone, where the film keeps halves (`Film::new`):
+    /// with `sums`, two independent half estimates, whose difference
+    /// measures the estimate's noise (`variance`).
+    pub odd_sums: Vec<[f64; 3]>,
     /// Passes added to every pixel of the tile.
     pub samples: u32,
 }
 
+/// An estimated relMSE and its standard error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoiseEstimate {
+    pub rel_mse: f64,
+    pub standard_error: f64,
+}
+
+/// Sums of per-pixel terms, to make a mean and its standard error of.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TermSums {
+    pub sum: f64,
+    pub squares: f64,
+    pub count: u64,
+}
+
+impl TermSums {
+    pub fn push(&mut self, term: f64) {
+        self.sum += term;
+        self.squares += term * term;
+        self.count += 1;
+    }
+
+    pub fn add(&mut self, other: &TermSums) {
+        self.sum += other.sum;
+        self.squares += other.squares;
+        self.count += other.count;
+    }
+
+    /// The terms' mean and its standard error (None without two terms).
+    pub fn estimate(&self) -> Option<NoiseEstimate> {
+        if self.count < 2 {
+            return None;
+        }
+        let n = self.count as f64;
+        let mean = self.sum / n;
+        let variance = ((self.squares - n * mean * mean) / (n - 1.0)).max(0.0);
+        Some(NoiseEstimate { rel_mse: mean, standard_error: (variance / n).sqrt() })
+    }
+}
+
 impl FilmTile {
-    pub fn new(rect: TileRect) -> Self {
-        Self { rect, sums: vec![[0.0; 3]; rect.pixels()], samples: 0 }
+    pub fn new(rect: TileRect, halves: bool) -> Self {
+        let odd_sums = if halves { vec![[0.0; 3]; rect.pixels()] } else { Vec::new() };
+        Self { rect, sums: vec![[0.0; 3]; rect.pixels()], odd_sums, samples: 0 }
     }
 
     /// The tile's current estimate, row-major.
@@ -49,13 +98,61 @@ impl FilmTile {
         self.sums.iter().map(|s| s.map(|c| (c * scale) as f32)).collect()
     }
 
-    /// Add one value (a sample, or the splats' sum) to pixel `i` of the tile.
+    /// Add one value (a sample, or the splats' sum) to pixel `i` of the
+    /// tile, in the pass that `samples` is about to count.
     #[inline]
     pub fn add(&mut self, i: usize, value: Rgb) {
         let sum = &mut self.sums[i];
         for c in 0..3 {
             sum[c] += value[c] as f64;
         }
+        if self.samples % 2 == 1 && !self.odd_sums.is_empty() {
+            let odd = &mut self.odd_sums[i];
+            for c in 0..3 {
+                odd[c] += value[c] as f64;
+            }
+        }
+    }
+
+    /// Each pixel's (mean, estimated variance of the mean), channel by
+    /// channel, where the film keeps halves and has two passes: of n
+    /// passes, n_o odd and n_e even, the halves' means differ by a quantity
+    /// of variance σ²(1/n_e + 1/n_o), and the mean's is σ²/n, so
+    /// (m_e − m_o)² n_e n_o / n² is an unbiased estimate of it.
+    pub fn mean_and_variance(&self) -> Option<impl Iterator<Item = ([f64; 3], [f64; 3])> + '_> {
+        let n = self.samples as f64;
+        let odd = (self.samples / 2) as f64;
+        let even = n - odd;
+        if self.odd_sums.is_empty() || odd < 1.0 {
+            return None;
+        }
+        let scale = even * odd / (n * n);
+        Some(self.sums.iter().zip(&self.odd_sums).map(move |(sum, odd_sum)| {
+            let mean = sum.map(|s| s / n);
+            let variance = std::array::from_fn(|c| {
+                let (m_odd, m_even) = (odd_sum[c] / odd, (sum[c] - odd_sum[c]) / even);
+                (m_even - m_odd).powi(2) * scale
+            });
+            (mean, variance)
+        }))
+    }
+
+    /// The estimated variance of every pixel's mean (`mean_and_variance`).
+    pub fn variance(&self) -> Option<Vec<[f32; 3]>> {
+        Some(self.mean_and_variance()?.map(|(_, v)| v.map(|c| c as f32)).collect())
+    }
+
+    /// The tile's terms of the estimate's own relMSE: variance/(mean² + ε)
+    /// per pixel and channel (an unbiased method's error against the
+    /// converged image it tends to, as a denoiser estimates noise).
+    pub fn noise_terms(&self) -> TermSums {
+        let mut terms = TermSums::default();
+        if let Some(pixels) = self.mean_and_variance() {
+            for (mean, variance) in pixels {
+                (0..3).for_each(|c| terms.push(variance[c] / (mean[c] * mean[c] + REL_MSE_EPSILON)));
+            }
+        }
+        terms
     }
 }
 
@@ -79,9 +176,12 @@ pub struct Film {
 }
 
 impl Film {
-    pub fn new(width: u32, height: u32, tile_size: u32) -> Self {
+    /// A film of `width × height` in tiles of `tile_size`, keeping the odd
+    /// passes apart where `halves` (for an estimate of its noise).
+    pub fn new(width: u32, height: u32, tile_size: u32, halves: bool) -> Self {
         let tile_size = tile_size.max(1);
-        let tiles: Vec<FilmTile> = tile_layout(width, height, tile_size).into_iter().map(FilmTile::new).collect();
+        let tiles: Vec<FilmTile> =
+            tile_layout(width, height, tile_size).into_iter().map(|rect| FilmTile::new(rect, halves)).collect();
         let columns = width.div_ceil(tile_size);
         let mut tile_of_cell = vec![0; (columns * height.div_ceil(tile_size)) as usize];
         for (i, tile) in tiles.iter().enumerate() {
@@ -104,6 +204,14 @@ impl Film {
             let rect = tile.rect;
             tile.add(((splat.y - rect.y) * rect.width + splat.x - rect.x) as usize, splat.value);
         }
+    }
+
+    /// Every pixel's estimated variance (`FilmTile::variance`), where the
+    /// film keeps halves and has two passes.
+    pub fn variance(&self) -> Option<LinearImage> {
+        let per_tile: Option<Vec<Vec<[f32; 3]>>> = self.tiles.iter().map(FilmTile::variance).collect();
+        let per_tile = per_tile?;
+        Some(self.image(|i| per_tile[i].clone()))
     }
 
     /// The whole image from each tile's pixels (`tile_pixels(i)` row-major).
@@ -152,9 +260,9 @@ mod tests {
             let (x, y) = ((state >> 33) as u32 % (w + 3), (state >> 13) as u32 % (h + 2));
             splats.push(Splat { x, y, value: Rgb::splat((state >> 40) as f32 / 1e6 + 1e-3) });
         }
-        let mut whole = Film::new(w, h, 16);
+        let mut whole = Film::new(w, h, 16, false);
         whole.add_splats([splats.clone()]);
-        let mut chunked = Film::new(w, h, 16);
+        let mut chunked = Film::new(w, h, 16, false);
         chunked.add_splats(splats.chunks(37).map(<[Splat]>::to_vec));
         let mut expected = vec![[0.0f64; 3]; (w * h) as usize];
         for s in splats.iter().filter(|s| s.x < w && s.y < h) {

@@ -16,7 +16,9 @@ pub mod integrators;
 pub mod settings;
 pub mod world;
 
-pub use engine::{render_blocking, PassStats, RenderEvent, RenderJob, RenderSession, TileUpdate};
+pub use engine::{
+    render_blocking, render_blocking_on, PassStats, RenderEvent, RenderJob, RenderSession, TileUpdate, Workers,
+};
 pub use image::LinearImage;
 pub use integrators::PhotonPassStats;
 pub use settings::{Algorithm, Method, PhotonSettings, RenderSettings, SppmSettings};

@@ -37,6 +37,13 @@ impl Algorithm {
         }
     }
 
+    /// Whether its passes are independent unbiased estimates of the
+    /// converged image: then the spread between them is its error, and the
+    /// film keeps its odd passes apart to measure it.
+    pub fn is_unbiased(self) -> bool {
+        self == Algorithm::Path
+    }
+
     /// The thesis' depth 5 for Whitted; the Monte Carlo methods end paths by
     /// Russian roulette well before their cap.
     pub fn default_max_depth(self) -> u32 {
@@ -147,8 +154,6 @@ pub struct RenderSettings {
     /// Stop once this many seconds have passed (checked between passes).
     pub time_limit: Option<f64>,
     pub seed: u64,
-    /// Worker threads; 0 uses every core.
-    pub threads: usize,
     pub max_depth: u32,
     /// Off (0) by default: clamping hides bias. When set, each sample's
     /// channels are limited to this value.
@@ -167,7 +172,6 @@ impl Default for RenderSettings {
             samples_per_pixel: None,
             time_limit: None,
             seed: 0,
-            threads: 0,
             max_depth: Algorithm::Path.default_max_depth(),
             firefly_clamp: 0.0,
             preview: false,
@@ -241,7 +245,6 @@ impl RenderSettings {
         check("size", limits::check_image_size(self.width, self.height));
         check("samples_per_pixel", self.samples_per_pixel.map_or(Ok(()), |n| ok(limits::SAMPLES_PER_PIXEL.check(n))));
         check("time_limit", self.time_limit.map_or(Ok(()), |t| ok(limits::SECONDS.check(t))));
-        check("threads", ok(limits::THREADS.check(self.threads)));
         check("max_depth", ok(limits::MAX_DEPTH.check(self.max_depth)));
         check("firefly_clamp", ok(limits::LENGTH.check(self.firefly_clamp)));
         check("tile_size", ok(limits::TILE_SIZE.check(self.tile_size)));
@@ -279,13 +282,12 @@ mod tests {
         }
         let bad = RenderSettings {
             width: 100_000,
-            threads: 100_000,
             tile_size: 0,
             time_limit: Some(f64::NAN),
             method: Method::Photon(PhotonSettings { k_nearest: u32::MAX, ..PhotonSettings::default() }),
             ..RenderSettings::default()
         };
         let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
-        assert_eq!(fields, ["size", "time_limit", "threads", "tile_size", "k_nearest"]);
+        assert_eq!(fields, ["size", "time_limit", "tile_size", "k_nearest"]);
     }
 }

@@ -3,6 +3,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
+use crate::render::film::NoiseEstimate;
 use crate::render::image::LinearImage;
 use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::integrators::PhotonPassStats;
@@ -19,6 +20,9 @@ pub struct TileUpdate {
     pub pixels: Vec<[f32; 3]>,
     /// A coarse block-filled preview, not yet part of the estimate.
     pub preview: bool,
+    /// Each pixel's estimated variance of its mean, when the job asked
+    /// for it (`RenderJob::stream_variance`) and the method keeps it.
+    pub variance: Option<Vec<[f32; 3]>>,
 }
 
 /// What the engine tells its driver. Every event names the generation (the
@@ -43,6 +47,9 @@ pub enum RenderEvent {
     Finished {
         generation: u64,
         image: Arc<LinearImage>,
+        /// Each pixel's estimated variance of its mean, for unbiased
+        /// methods (`Algorithm::is_unbiased`) after two passes.
+        variance: Option<Arc<LinearImage>>,
         stats: PassStats,
     },
     Failed {
@@ -78,6 +85,9 @@ pub struct PassStats {
     pub non_finite: u64,
     /// Photon work of the last pass (photon mapping and SPPM).
     pub photon: PhotonPassStats,
+    /// The image's relMSE against the converged image it tends to, from its
+    /// own noise: for unbiased methods after two passes.
+    pub noise: Option<NoiseEstimate>,
 }
 
 impl PassStats {

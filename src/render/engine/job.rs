@@ -11,6 +11,7 @@ use crossbeam_channel::Sender;
 use rayon::prelude::*;
 
 use super::events::{Notify, PassStats, RenderEvent, TileUpdate};
+use super::workers::Workers;
 use crate::render::film::Film;
 use crate::render::integrators::photon_map::PhotonMaps;
 use crate::render::integrators::{Integrator, PassObserver, Stage};
@@ -30,11 +31,14 @@ pub struct RenderJob {
     /// Send every tile's image after each pass (what a viewport or a
     /// convergence log reads); a batch render wants only the final image.
     pub stream_tiles: bool,
+    /// With each streamed tile, its pixels' estimated variance (a reference
+    /// being made while it is used).
+    pub stream_variance: bool,
 }
 
 impl RenderJob {
     pub fn new(scene: Arc<ValidScene>, settings: RenderSettings) -> Self {
-        Self { scene, settings, photon_maps: None, stream_tiles: true }
+        Self { scene, settings, photon_maps: None, stream_tiles: true, stream_variance: false }
     }
 }
 
@@ -43,6 +47,7 @@ impl RenderJob {
 pub(super) struct JobContext<'a> {
     pub generation: u64,
     pub stream_tiles: bool,
+    pub stream_variance: bool,
     pub current: &'a AtomicU64,
     pub events: &'a Sender<RenderEvent>,
     pub notify: Option<&'a Notify>,
@@ -68,12 +73,22 @@ impl PassObserver for JobContext<'_> {
         self.stream_tiles
     }
 
-    fn tile(&self, rect: TileRect, pixels: Vec<[f32; 3]>) {
-        self.send(RenderEvent::Tile(TileUpdate { generation: self.generation, rect, pixels, preview: false }));
+    fn wants_variance(&self) -> bool {
+        self.stream_variance
+    }
+
+    fn tile(&self, rect: TileRect, pixels: Vec<[f32; 3]>, variance: Option<Vec<[f32; 3]>>) {
+        let generation = self.generation;
+        self.send(RenderEvent::Tile(TileUpdate { generation, rect, pixels, preview: false, variance }));
     }
 }
 
-pub(super) fn run_job(context: &JobContext, job: &RenderJob) {
+/// Render `job` on `workers`. Each stage (preparing, the preview, every
+/// pass) is handed to the pool on its own: the pool is shared, and a thread
+/// waiting inside one job's parallel loop may pick up another's queued
+/// stage, so a stage is all another job ever waits for; a whole render
+/// handed over at once could hold a pane behind a 4096-pass reference.
+pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) {
     let settings = &job.settings;
     let generation = context.generation;
     if let Some(problem) = settings.problems().into_iter().next() {
@@ -84,9 +99,10 @@ pub(super) fn run_job(context: &JobContext, job: &RenderJob) {
     let (world, visible_radius) = World::for_view(&job.scene, &camera, settings.width, settings.height);
     let stage = Stage { world: &world, camera: &camera, settings };
     let start = Instant::now();
-    let mut film = Film::new(settings.width, settings.height, settings.tile_size);
-    let Some(mut integrator) = Integrator::prepare(&stage, &film, visible_radius, job.photon_maps.clone(), context)
-    else {
+    let halves = settings.algorithm().is_unbiased();
+    let mut film = Film::new(settings.width, settings.height, settings.tile_size, halves);
+    let prepared = workers.run(|| Integrator::prepare(&stage, &film, visible_radius, job.photon_maps.clone(), context));
+    let Some(mut integrator) = prepared else {
         return;
     };
     if let Some(stats) = integrator.photon_maps() {
@@ -95,11 +111,14 @@ pub(super) fn run_job(context: &JobContext, job: &RenderJob) {
     context.send(RenderEvent::Started { generation, width: settings.width, height: settings.height });
 
     if settings.preview {
-        film.tiles.par_iter().with_max_len(1).for_each(|tile| {
-            if context.is_current() {
-                let pixels = integrator.preview_tile(&stage, tile.rect);
-                context.send(RenderEvent::Tile(TileUpdate { generation, rect: tile.rect, pixels, preview: true }));
-            }
+        workers.run(|| {
+            film.tiles.par_iter().with_max_len(1).for_each(|tile| {
+                if context.is_current() {
+                    let pixels = integrator.preview_tile(&stage, tile.rect);
+                    let update = TileUpdate { generation, rect: tile.rect, pixels, preview: true, variance: None };
+                    context.send(RenderEvent::Tile(update));
+                }
+            })
         });
     }
 
@@ -112,7 +131,7 @@ pub(super) fn run_job(context: &JobContext, job: &RenderJob) {
             break;
         }
         let pass_start = Instant::now();
-        let Some(report) = integrator.pass(&stage, &mut film, stats.passes, context) else {
+        let Some(report) = workers.run(|| integrator.pass(&stage, &mut film, stats.passes, context)) else {
             return;
         };
         stats.rays += report.counters.rays;
@@ -122,8 +141,10 @@ pub(super) fn run_job(context: &JobContext, job: &RenderJob) {
         stats.pass_time = pass_start.elapsed();
         stats.elapsed = start.elapsed();
         stats.photon = report.photon;
+        stats.noise = report.noise.estimate();
         context.send(RenderEvent::PassFinished { generation, stats });
     }
     let image = film.image(|tile| integrator.tile_pixels(&film, tile));
-    context.send(RenderEvent::Finished { generation, image: Arc::new(image), stats });
+    let variance = film.variance().map(Arc::new);
+    context.send(RenderEvent::Finished { generation, image: Arc::new(image), variance, stats });
 }

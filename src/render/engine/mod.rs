@@ -6,7 +6,9 @@
 mod events;
 mod job;
 mod session;
+mod workers;
 
 pub use events::{Notify, PassStats, RenderEvent, TileUpdate};
 pub use job::RenderJob;
-pub use session::{render_blocking, RenderSession};
+pub use session::{render_blocking, render_blocking_on, RenderSession};
+pub use workers::Workers;

@@ -10,6 +10,7 @@ use crossbeam_channel::{Receiver, Sender};
 
 use super::events::{Notify, PassStats, RenderEvent};
 use super::job::{run_job, JobContext, RenderJob};
+use super::workers::Workers;
 use crate::render::image::LinearImage;
 
 enum Command {
@@ -17,33 +18,44 @@ enum Command {
     Shutdown,
 }
 
-/// Handle to a background render worker: start (or restart) with a new scene
-/// snapshot, cancel, and read events. Never blocks the caller.
+/// Handle to a background render job: start (or restart) with a new scene
+/// snapshot, cancel, and read events. Never blocks the caller. Its passes
+/// run on `Workers` it may share with other sessions.
 pub struct RenderSession {
     commands: Sender<Command>,
     events: Receiver<RenderEvent>,
+    /// The worker's own sender, to report a worker that is gone.
+    failures: Sender<RenderEvent>,
     generation: Arc<AtomicU64>,
     worker: Option<JoinHandle<()>>,
 }
 
 impl RenderSession {
-    /// Start the session's worker thread (the OS may refuse one).
-    pub fn new(notify: Option<Notify>) -> std::io::Result<Self> {
+    /// Start the session's thread (the OS may refuse one), which runs its
+    /// jobs on `workers`.
+    pub fn new(workers: &Workers, notify: Option<Notify>) -> std::io::Result<Self> {
         let (commands, command_rx) = crossbeam_channel::unbounded();
         let (event_tx, events) = crossbeam_channel::unbounded();
         let generation = Arc::new(AtomicU64::new(0));
         let worker_generation = generation.clone();
+        let (workers, failures) = (workers.clone(), event_tx.clone());
         let worker = std::thread::Builder::new()
-            .name("render-worker".into())
-            .spawn(move || worker_loop(command_rx, event_tx, worker_generation, notify))?;
-        Ok(Self { commands, events, generation, worker: Some(worker) })
+            .name("render-session".into())
+            .spawn(move || worker_loop(&workers, command_rx, event_tx, worker_generation, notify))?;
+        Ok(Self { commands, events, failures, generation, worker: Some(worker) })
     }
 
     /// Start rendering `job`, abandoning whatever was in flight. Returns the
-    /// new generation; events of older ones may still arrive and should be dropped.
+    /// new generation; events of older ones may still arrive and should be
+    /// dropped. Should the session's thread be gone (a bug that panicked
+    /// it), the job fails at once with that said.
     pub fn start(&self, job: RenderJob) -> u64 {
         let generation = self.generation.fetch_add(1, Ordering::SeqCst) + 1;
-        let _ = self.commands.send(Command::Start(generation, job));
+        if self.commands.send(Command::Start(generation, job)).is_err() {
+            let message = "the render thread has stopped; restart the program".to_string();
+            // The receiver is ours: this cannot fail
+            let _ = self.failures.send(RenderEvent::Failed { generation, message });
+        }
         generation
     }
 
@@ -72,12 +84,12 @@ impl Drop for RenderSession {
 }
 
 fn worker_loop(
+    workers: &Workers,
     commands: Receiver<Command>,
     events: Sender<RenderEvent>,
     generation: Arc<AtomicU64>,
     notify: Option<Notify>,
 ) {
-    let mut pools: Option<(usize, rayon::ThreadPool)> = None;
     while let Ok(mut command) = commands.recv() {
         // Only the newest queued job matters
         while let Ok(newer) = commands.try_recv() {
@@ -89,38 +101,33 @@ fn worker_loop(
         if generation.load(Ordering::SeqCst) != job_generation {
             continue;
         }
-        let threads = job.settings.threads;
-        if pools.as_ref().is_none_or(|(n, _)| *n != threads) {
-            match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
-                Ok(pool) => pools = Some((threads, pool)),
-                Err(e) => {
-                    let message = format!("could not start {threads} render threads: {e}");
-                    let _ = events.send(RenderEvent::Failed { generation: job_generation, message });
-                    continue;
-                }
-            }
-        }
-        if let Some((_, pool)) = &pools {
-            let context = JobContext {
-                generation: job_generation,
-                stream_tiles: job.stream_tiles,
-                current: &generation,
-                events: &events,
-                notify: notify.as_ref(),
-            };
-            pool.install(|| run_job(&context, &job));
-        }
+        let context = JobContext {
+            generation: job_generation,
+            stream_tiles: job.stream_tiles,
+            stream_variance: job.stream_variance,
+            current: &generation,
+            events: &events,
+            notify: notify.as_ref(),
+        };
+        run_job(workers, &context, &job);
     }
 }
 
-/// Render a job to completion on its own session, for tests and tools that
-/// want just the image (and the final statistics).
+/// Render a job to completion on its own session and the process's shared
+/// workers, for tests and tools that want just the image (and the final
+/// statistics).
 pub fn render_blocking(job: &RenderJob) -> Result<(LinearImage, PassStats), String> {
-    let session = RenderSession::new(None).map_err(|e| format!("could not start the render worker: {e}"))?;
+    let workers = Workers::shared().ok_or("could not start the render threads")?;
+    render_blocking_on(workers, job)
+}
+
+/// `render_blocking` on `workers`.
+pub fn render_blocking_on(workers: &Workers, job: &RenderJob) -> Result<(LinearImage, PassStats), String> {
+    let session = RenderSession::new(workers, None).map_err(|e| format!("could not start the render worker: {e}"))?;
     let generation = session.start(RenderJob { stream_tiles: false, ..job.clone() });
     for event in session.events().iter() {
         match event {
-            RenderEvent::Finished { generation: g, image, stats } if g == generation => {
+            RenderEvent::Finished { generation: g, image, stats, .. } if g == generation => {
                 return Ok((Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone()), stats));
             }
             RenderEvent::Failed { generation: g, message } if g == generation => return Err(message),

@@ -18,7 +18,7 @@ use std::time::Duration;
 
 use rayon::prelude::*;
 
-use crate::render::film::{Film, FilmTile};
+use crate::render::film::{Film, FilmTile, TermSums};
 use crate::render::settings::{Method, RenderSettings};
 use crate::render::world::camera::{CameraModel, CameraTile, TileRect};
 use crate::render::world::rng::PassStreams;
@@ -60,6 +60,8 @@ pub struct PhotonPassStats {
 pub struct PassReport {
     pub counters: Counters,
     pub photon: PhotonPassStats,
+    /// The terms of the estimate's own relMSE, where the film keeps halves.
+    pub noise: TermSums,
 }
 
 /// Everything a pass reads: shared, immutable, built once per job.
@@ -96,7 +98,9 @@ pub trait PassObserver: Sync {
     fn is_current(&self) -> bool;
     /// Whether the driver wants each tile's estimate after each pass.
     fn wants_tiles(&self) -> bool;
-    fn tile(&self, rect: TileRect, pixels: Vec<[f32; 3]>);
+    /// Whether it wants each pixel's estimated variance with it.
+    fn wants_variance(&self) -> bool;
+    fn tile(&self, rect: TileRect, pixels: Vec<[f32; 3]>, variance: Option<Vec<[f32; 3]>>);
 }
 
 /// Sample index used for the coarse preview, outside any real pass's range.
@@ -185,7 +189,7 @@ impl Integrator {
         observer: &dyn PassObserver,
     ) -> Option<PassReport> {
         let streams = stage.streams(pass as u64);
-        let per_tile: Vec<Counters> = film
+        let per_tile: Vec<(Counters, TermSums)> = film
             .tiles
             .par_iter_mut()
             // one tile a task: rayon's default leaves are a quarter of the
@@ -194,21 +198,24 @@ impl Integrator {
             .with_max_len(1)
             .map(|tile| {
                 let mut counters = Counters::default();
-                if observer.is_current() {
-                    self.render_tile(stage, tile, streams, &mut counters);
-                    if observer.wants_tiles() {
-                        observer.tile(tile.rect, tile.mean());
-                    }
+                if !observer.is_current() {
+                    return (counters, TermSums::default());
                 }
-                counters
+                self.render_tile(stage, tile, streams, &mut counters);
+                if observer.wants_tiles() {
+                    let variance = if observer.wants_variance() { tile.variance() } else { None };
+                    observer.tile(tile.rect, tile.mean(), variance);
+                }
+                (counters, tile.noise_terms())
             })
             .collect();
         if !observer.is_current() {
             return None;
         }
         let mut report = PassReport::default();
-        for counters in &per_tile {
+        for (counters, noise) in &per_tile {
             report.counters.add(counters);
+            report.noise.add(noise);
         }
         report.photon.queries = report.counters.queries;
         Some(report)

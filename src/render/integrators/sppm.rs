@@ -128,7 +128,8 @@ impl Sppm {
                 }
                 tile.samples += 1;
                 if observer.wants_tiles() {
-                    observer.tile(tile.rect, pixels.iter().map(|p| p.value(tile.samples).to_array()).collect());
+                    let pixels = pixels.iter().map(|p| p.value(tile.samples).to_array()).collect();
+                    observer.tile(tile.rect, pixels, None);
                 }
                 (sum, pixels.len())
             })

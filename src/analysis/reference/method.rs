@@ -1,0 +1,86 @@
+//! How a scene's reference is made: by which method, at which size, with
+//! which seed.
+
+use crate::render::{Algorithm, RenderSettings};
+use crate::scene::{MaterialModel, Scene};
+
+/// References are rendered with their own seed: a pane's path tracer with
+/// the default seed 0 would otherwise draw the very samples the reference's
+/// first passes drew, and its error would look smaller than it is.
+pub const REFERENCE_SEED: u64 = 0x7265_6665_7265_6e63;
+
+/// The method a scene's reference needs, and why, as the studio says it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ReferenceMethod {
+    pub algorithm: Algorithm,
+    pub reason: &'static str,
+}
+
+/// Path tracing where its estimate converges; SPPM (consistent) where
+/// light can reach the camera only through mirrors or glass from a point,
+/// spot or directional light — a caustic path tracing never finds, since
+/// no direction it samples can hit a delta light.
+pub fn reference_method(scene: &Scene) -> ReferenceMethod {
+    let delta_light = scene.lights.iter().any(|l| l.enabled && l.intensity > 0.0 && l.color.max_element() > 0.0);
+    let specular = scene.objects.iter().any(|o| {
+        let model = scene.material_index(&o.material).map(|m| &scene.materials[m].model);
+        matches!(model, Some(MaterialModel::Mirror { .. } | MaterialModel::Glass { .. }))
+    });
+    if delta_light && specular {
+        ReferenceMethod {
+            algorithm: Algorithm::Sppm,
+            reason: "progressive photon mapping: a point-like light shines through mirrors or glass, a caustic path tracing cannot find",
+        }
+    } else {
+        ReferenceMethod { algorithm: Algorithm::Path, reason: "path tracing: it converges on this scene" }
+    }
+}
+
+/// References are made at half the scene's size (the four-pane size):
+/// a pane at full size is compared after a 2×2 box filter, which is what a
+/// half-size render estimates.
+pub fn reference_size(scene: &Scene) -> (u32, u32) {
+    ((scene.settings.width / 2).max(1), (scene.settings.height / 2).max(1))
+}
+
+/// How `algorithm` renders a reference of `scene` at `width × height`:
+/// 4096 samples per pixel (passes, for SPPM), its own seed.
+pub fn reference_settings(algorithm: Algorithm, width: u32, height: u32) -> RenderSettings {
+    RenderSettings {
+        width,
+        height,
+        samples_per_pixel: Some(4096),
+        seed: REFERENCE_SEED,
+        ..RenderSettings::for_algorithm(algorithm)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::presets;
+
+    #[test]
+    fn a_point_light_through_glass_asks_for_photons_and_nothing_else_does() {
+        let method = |name: &str| reference_method(&presets::preset(name).unwrap().unwrap().into_scene()).algorithm;
+        // Area lights only, or point lights without mirrors or glass
+        for name in ["cornell", "smallpt", "caustics", "lights"] {
+            assert_eq!(method(name), Algorithm::Path, "{name}");
+        }
+        // The thesis' chrome ball throws the key light's caustic on the ground
+        assert_eq!(method("thesis"), Algorithm::Sppm);
+        let mut scene = presets::preset("cornell").unwrap().unwrap().into_scene();
+        let point = crate::scene::LightKind::Point { position: glam::Vec3::new(0.0, 1.5, 0.0) };
+        scene.lights.push(crate::scene::Light {
+            name: "bulb".into(),
+            kind: point,
+            color: glam::Vec3::ONE,
+            intensity: 2.0,
+            attenuation: Default::default(),
+            enabled: true,
+        });
+        assert_eq!(reference_method(&scene).algorithm, Algorithm::Sppm);
+        scene.lights[0].enabled = false;
+        assert_eq!(reference_method(&scene).algorithm, Algorithm::Path);
+    }
+}
