@@ -155,11 +155,9 @@ pub fn open_regular(path: &Path, max: u64) -> Result<File, FileError> {
 mod tests {
     use super::*;
 
-    fn folder(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("gi-fileio-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        dir
+    /// A fresh folder, removed when the test ends.
+    fn folder(name: &str) -> tempfile::TempDir {
+        tempfile::Builder::new().prefix(&format!("gi-fileio-{name}-")).tempdir().unwrap()
     }
 
     fn entries(dir: &Path) -> Vec<String> {
@@ -171,7 +169,8 @@ mod tests {
 
     #[test]
     fn a_failed_write_leaves_the_old_file_whole_and_no_partial_file() {
-        let dir = folder("fail");
+        let temp = folder("fail");
+        let dir = temp.path();
         let path = dir.join("image.png");
         fs::write(&path, b"the user's image").unwrap();
         let error = write_atomic(&path, |out| {
@@ -181,27 +180,29 @@ mod tests {
         .unwrap_err();
         assert_eq!(error.to_string(), format!("{}: disk full", path.display()));
         assert_eq!(fs::read(&path).unwrap(), b"the user's image");
-        assert_eq!(entries(&dir), vec!["image.png"]);
+        assert_eq!(entries(dir), vec!["image.png"]);
     }
 
     #[cfg(unix)]
     #[test]
     fn a_completed_write_replaces_the_file_keeping_its_permissions() {
         use std::os::unix::fs::PermissionsExt;
-        let dir = folder("ok");
+        let temp = folder("ok");
+        let dir = temp.path();
         let path = dir.join("scene.ron");
         fs::write(&path, b"old").unwrap();
         fs::set_permissions(&path, fs::Permissions::from_mode(0o600)).unwrap();
         write_bytes(&path, b"new").unwrap();
         assert_eq!(fs::read(&path).unwrap(), b"new");
         assert_eq!(fs::metadata(&path).unwrap().permissions().mode() & 0o777, 0o600);
-        assert_eq!(entries(&dir), vec!["scene.ron"]);
+        assert_eq!(entries(dir), vec!["scene.ron"]);
     }
 
     #[cfg(unix)]
     #[test]
     fn a_link_keeps_pointing_at_the_replaced_file() {
-        let dir = folder("link");
+        let temp = folder("link");
+        let dir = temp.path();
         let real = dir.join("real.png");
         fs::write(&real, b"old").unwrap();
         std::os::unix::fs::symlink(&real, dir.join("link.png")).unwrap();
@@ -224,7 +225,8 @@ mod tests {
 
     #[test]
     fn only_signed_files_are_replaceable() {
-        let dir = folder("sign");
+        let temp = folder("sign");
+        let dir = temp.path();
         let ours = dir.join("ours.png");
         fs::write(&ours, [b"\x89PNG....tEXtSoftware\0".as_slice(), SIGNATURE.as_bytes()].concat()).unwrap();
         let theirs = dir.join("theirs.png");
@@ -234,18 +236,19 @@ mod tests {
         assert!(!replaceable(&theirs, sign).unwrap());
         assert!(replaceable(&dir.join("new.png"), sign).unwrap());
         assert!(replaceable(Path::new("/dev/null"), sign).unwrap());
-        assert!(!replaceable(&dir, sign).unwrap());
+        assert!(!replaceable(dir, sign).unwrap());
     }
 
     #[test]
     fn reads_refuse_what_is_not_a_bounded_regular_file() {
-        let dir = folder("read");
+        let temp = folder("read");
+        let dir = temp.path();
         let path = dir.join("scene.ron");
         fs::write(&path, "(camera: ())").unwrap();
         assert_eq!(read_text(&path, 100).unwrap(), "(camera: ())");
         assert!(matches!(read_text(&path, 5), Err(FileError::TooLarge { size: 12, max: 5, .. })));
         assert!(matches!(read_text(Path::new("/dev/zero"), 100), Err(FileError::NotRegular { .. })));
-        assert!(matches!(read_text(&dir, 100), Err(FileError::NotRegular { .. })));
+        assert!(matches!(read_text(dir, 100), Err(FileError::NotRegular { .. })));
         fs::write(&path, [0xff, 0xfe]).unwrap();
         assert!(read_text(&path, 100).unwrap_err().to_string().ends_with("not UTF-8 text"));
         let missing = read_text(&dir.join("missing.ron"), 100).unwrap_err().to_string();

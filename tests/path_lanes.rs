@@ -141,3 +141,15 @@ fn only_scenes_of_spheres_take_lanes() {
     let (smallpt, _) = world(&preset("smallpt"), 8, 6);
     assert!(PathLanes::new(&smallpt).is_some());
 }
+
+/// The tests above compare the eight lanes with the scalar code only where
+/// the lanes run: on an x86-64 CPU without AVX2 the tracer falls back to
+/// the scalar code and they would compare it with itself. Say so loudly
+/// instead of passing.
+#[test]
+fn the_lanes_under_test_are_the_eight_lane_tracer() {
+    assert!(
+        PathLanes::runs_in_lanes(),
+        "this CPU lacks AVX2: the lane tests would compare the scalar tracer with itself"
+    );
+}

@@ -158,7 +158,7 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
     let camera = CameraModel::new(&scene.camera, s.width, s.height);
     let (world, visible) = World::for_view(&valid(scene.clone()), &camera, s.width, s.height);
     let maps = PhotonMaps::build(&world, s.photon().unwrap(), s.seed, s.max_depth, visible);
-    let dir = std::env::temp_dir().join(format!("gi-pmap-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-pmap-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("caustics.pmap");
     let (scene_key, key) = (scene.content_key(), settings_key(s.photon().unwrap(), s.seed, s.max_depth));
@@ -207,7 +207,7 @@ fn damaged_photon_maps_are_refused_each_with_its_own_message() {
     let (world, visible) = World::for_view(&valid(scene.clone()), &camera, s.width, s.height);
     let maps = PhotonMaps::build(&world, s.photon().unwrap(), s.seed, s.max_depth, visible);
     assert!(maps.global.len() > 100);
-    let dir = std::env::temp_dir().join(format!("gi-pmap-damage-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-pmap-damage-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (scene_key, key) = (scene.content_key(), settings_key(s.photon().unwrap(), s.seed, s.max_depth));
     let good = dir.join("good.pmap");

@@ -269,7 +269,8 @@ fn any_flags_give_an_error_or_settings_within_limits() {
 #[test]
 fn any_bytes_as_a_photon_map_are_refused() {
     in_capped_child("any_bytes_as_a_photon_map_are_refused", || {
-        let dir = std::env::temp_dir().join(format!("gi-robust-pmap-{}", std::process::id()));
+        let dir =
+            std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-robust-pmap-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("random.pmap");
         proptest!(fixed_cases(500, 4), |(tail in prop::collection::vec(any::<u8>(), 0..400), keep_magic in any::<bool>())| {

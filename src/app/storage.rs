@@ -251,7 +251,8 @@ mod tests {
 
     #[test]
     fn state_round_trips_and_a_broken_file_gives_a_notice() {
-        let dir = std::env::temp_dir().join(format!("gi-state-{}", std::process::id()));
+        let temp = tempfile::tempdir().unwrap();
+        let dir = temp.path().to_path_buf();
         let path = dir.join("app.ron");
         let _ = std::fs::remove_dir_all(&dir);
         let (mut state, notice) = StateFile::open(path.clone());

@@ -78,7 +78,8 @@ mod tests {
 
     #[test]
     fn inputs_others_files_and_twice_written_outputs_are_refused() {
-        let dir = std::env::temp_dir().join(format!("gi-outputs-{}", std::process::id()));
+        let temp = tempfile::tempdir().unwrap();
+        let dir = temp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         let scene = dir.join("scene.ron");
         std::fs::write(&scene, "()").unwrap();

@@ -250,7 +250,8 @@ mod tests {
 
     #[test]
     fn exr_round_trip_is_exact_and_png_decodes_to_size() {
-        let dir = std::env::temp_dir().join(format!("gi-image-{}", std::process::id()));
+        let temp = tempfile::tempdir().unwrap();
+        let dir = temp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         let mut img = LinearImage::new(3, 2);
         img.pixels[4] = [1.5, 0.25, 1e-3];
@@ -264,7 +265,8 @@ mod tests {
 
     #[test]
     fn saved_images_carry_the_signature_and_refuse_a_wrong_size() {
-        let dir = std::env::temp_dir().join(format!("gi-image-sign-{}", std::process::id()));
+        let temp = tempfile::tempdir().unwrap();
+        let dir = temp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         let img = LinearImage::new(5, 4);
         for name in ["s.png", "s.exr"] {

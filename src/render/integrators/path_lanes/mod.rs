@@ -163,6 +163,12 @@ impl PathLanes {
         })
     }
 
+    /// Whether `radiance` traces eight lanes at once on this CPU (AVX2 on
+    /// x86-64), rather than falling back to the scalar tracer.
+    pub fn runs_in_lanes() -> bool {
+        lanes::supported()
+    }
+
     /// The radiance of every camera sample of `tile`, into `out` (one per sample).
     pub fn radiance(&self, world: &World, tile: &CameraTile, max_depth: u32, out: &mut [Rgb], counters: &mut Counters) {
         if !lanes::supported() {
