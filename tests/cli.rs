@@ -27,7 +27,7 @@ fn capped(setup: &str) -> Command {
 }
 
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("gi-cli-{name}-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-cli-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -386,4 +386,98 @@ fn a_photon_map_claiming_billions_of_photons_is_refused_not_allocated() {
         .unwrap();
     assert_exit(&output, 1);
     assert!(stderr(&output).contains("claims 17179869184 photons"), "{}", stderr(&output));
+}
+
+// ---- References wherever the program runs -----------------------------------
+
+/// The rows of a bench CSV: (scene, relMSE) of each.
+fn relmse_rows(csv: &Path) -> Vec<(String, f64)> {
+    let text = std::fs::read_to_string(csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("scene,algorithm,seconds,spp,rays,relmse,relmse_se,flip"));
+    lines
+        .map(|line| {
+            let fields: Vec<&str> = line.split(',').collect();
+            (fields[0].to_owned(), fields[5].parse().unwrap_or_else(|_| panic!("a number in {line}")))
+        })
+        .collect()
+}
+
+/// The references kept in the cache under `cache` (XDG_CACHE_HOME).
+fn cached(cache: &Path) -> Vec<String> {
+    let dir = cache.join("gistudio").join("references");
+    if !dir.exists() {
+        return Vec::new();
+    }
+    entries(&dir).into_iter().filter(|name| name.ends_with(".exr")).collect()
+}
+
+#[test]
+fn bench_finds_the_presets_references_from_any_folder() {
+    let dir = temp_dir("bench-anywhere");
+    let (cache, out) = (dir.join("cache"), dir.join("results"));
+    // From the file system's root, with an empty cache and no reference
+    // rendered (a budget of 0 refuses a scene without one)
+    let output = gi_studio()
+        .current_dir("/")
+        .env("XDG_CACHE_HOME", &cache)
+        .args(["bench", "--budget", "0.05", "--algos", "path", "--reference-budget", "0", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_exit(&output, 0);
+    let rows = relmse_rows(&out.join("convergence.csv"));
+    for preset in gi_studio::scene::presets::names() {
+        let errors: Vec<f64> = rows.iter().filter(|(scene, _)| scene == preset).map(|(_, e)| *e).collect();
+        assert!(!errors.is_empty(), "no rows for {preset}");
+        assert!(errors.iter().all(|e| e.is_finite() && *e > 0.0), "{preset}: {errors:?}");
+    }
+    assert!(stdout(&output).contains("reference: path, 4096 spp"), "{}", stdout(&output));
+    assert_eq!(cached(&cache), Vec::<String>::new(), "the built-in references need no cache");
+}
+
+#[test]
+fn an_edited_scene_gets_its_own_reference_and_bench_measures_against_it_from_elsewhere() {
+    let dir = temp_dir("edited-reference");
+    let elsewhere = temp_dir("edited-reference-elsewhere");
+    let cache = dir.join("cache");
+    let preset = include_str!("../assets/scenes/cornell.ron");
+    let edited = preset.replace("width: 640, height: 480", "width: 64, height: 48");
+    assert_ne!(edited, preset);
+    let scene = dir.join("edited.ron");
+    std::fs::write(&scene, &edited).unwrap();
+    let bench = |scene: &Path, out: &str| {
+        let mut command = gi_studio();
+        command.current_dir(&elsewhere).env("XDG_CACHE_HOME", &cache);
+        command.args(["bench", "--budget", "0.05", "--algos", "path", "--reference-budget", "0", "--out", out]);
+        command.arg(scene).output().unwrap()
+    };
+    let reference = |scene: &Path| {
+        let mut command = gi_studio();
+        command.current_dir(&elsewhere).env("XDG_CACHE_HOME", &cache);
+        command.args(["reference", "--spp", "64"]).arg(scene).output().unwrap()
+    };
+    // No reference yet: one sentence naming the command that makes it
+    let refused = bench(&scene, "first");
+    assert_exit(&refused, 1);
+    let message = stderr(&refused);
+    assert!(message.contains("no reference for") && message.contains("gi-studio reference"), "{message}");
+    assert_eq!(message.trim().lines().count(), 1, "{message}");
+    // Made once, into the cache; bench from another folder then measures
+    let made = reference(&scene);
+    assert_exit(&made, 0);
+    assert!(stdout(&made).contains("path tracing"), "the method is named: {}", stdout(&made));
+    assert_eq!(cached(&cache).len(), 1);
+    let measured = bench(&scene, "second");
+    assert_exit(&measured, 0);
+    let rows = relmse_rows(&elsewhere.join("second").join("convergence.csv"));
+    assert!(!rows.is_empty() && rows.iter().all(|(name, e)| name == "edited" && e.is_finite()), "{rows:?}");
+    // A further edit is another scene: refused again, and its reference is
+    // a second entry beside the first
+    let further = dir.join("further.ron");
+    std::fs::write(&further, edited.replace("fov_y_degrees: 40.0", "fov_y_degrees: 41.0")).unwrap();
+    assert_exit(&bench(&further, "third"), 1);
+    assert_exit(&reference(&further), 0);
+    assert_eq!(cached(&cache).len(), 2);
+    assert_exit(&bench(&further, "fourth"), 0);
 }

@@ -12,8 +12,15 @@ use gi_studio::app::{Selection, StudioApp};
 use gi_studio::render::world::camera::CameraModel;
 use gi_studio::scene::Shape;
 
+/// The studio's arguments in tests: references kept under the target
+/// folder, never in the user's cache.
+fn test_args() -> StudioArgs {
+    let cache = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("studio-ui-references");
+    StudioArgs { reference_cache: Some(cache), ..Default::default() }
+}
+
 fn studio(panes: usize) -> Harness<'static, StudioApp> {
-    let args = StudioArgs { panes: Some(panes), ..Default::default() };
+    let args = StudioArgs { panes: Some(panes), ..test_args() };
     let mut app = StudioApp::new(&egui::Context::default(), None, &args);
     // Small images keep the tests quick
     for pane in app.panes_mut().list_mut() {
@@ -94,7 +101,7 @@ fn a_broken_file_shows_its_error_and_leaves_the_scene_unchanged() {
     let mut harness = studio(1);
     harness.run_steps(2);
     let before = harness.state().scene().clone();
-    let dir = std::env::temp_dir().join(format!("gi-ui-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-ui-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("broken.ron");
     std::fs::write(&path, include_str!("../assets/scenes/cornell.ron").replacen("ior: 1.5", "ior: -2.0", 1)).unwrap();
@@ -129,7 +136,8 @@ fn four_panes_show_four_algorithms() {
 fn exporting_a_pane_writes_a_png_of_the_panes_size() {
     let mut harness = studio(1);
     step_until(&mut harness, |app| app.panes().list()[0].state().passes() >= 1);
-    let path = std::env::temp_dir().join(format!("gi-ui-export-{}.png", std::process::id()));
+    let path =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-ui-export-{}.png", std::process::id()));
     harness.state_mut().export_pane(0, &path);
     let decoded = image::open(&path).expect("a PNG");
     assert_eq!((decoded.width(), decoded.height()), (64, 48));
@@ -216,14 +224,14 @@ impl eframe::Storage for MemoryStorage {
 fn layout_is_restored_and_an_unsaved_scene_is_offered_back() {
     let mut storage = MemoryStorage::default();
     let edited = {
-        let args = StudioArgs { panes: Some(2), ..Default::default() };
+        let args = StudioArgs { panes: Some(2), ..test_args() };
         let mut app = StudioApp::new(&egui::Context::default(), None, &args);
         app.edit_scene(|s| s.camera.fov_y_degrees = 55.0);
         eframe::App::save(&mut app, &mut storage);
         app.scene().clone()
     };
     // Next start: two panes again, and the edit offered back
-    let app = StudioApp::new(&egui::Context::default(), Some(&storage), &StudioArgs::default());
+    let app = StudioApp::new(&egui::Context::default(), Some(&storage), &test_args());
     assert_eq!(app.panes().count(), 2);
     assert!(app.offers_autosave());
     let mut harness =
@@ -256,7 +264,7 @@ fn an_unanswered_autosave_offer_keeps_the_autosave() {
     let edited = edited_cornell();
     let mut storage = autosaved_storage(&edited);
     let autosave = storage.get_string("autosave_scene");
-    let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &StudioArgs::default());
+    let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &test_args());
     assert!(app.offers_autosave());
     eframe::App::save(&mut app, &mut storage);
     assert_eq!(storage.get_string("autosave_scene"), autosave, "the unanswered offer's autosave was replaced");
@@ -277,7 +285,7 @@ fn a_screenshot_run_never_touches_the_saved_state() {
     let mut storage = autosaved_storage(&edited);
     storage.set_string("studio", "(panes: [], show_plots: false)".into());
     let before = storage.0.clone();
-    let args = StudioArgs { screenshot: Some(PathBuf::from("shot.png")), panes: Some(4), ..Default::default() };
+    let args = StudioArgs { screenshot: Some(PathBuf::from("shot.png")), panes: Some(4), ..test_args() };
     let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &args);
     assert!(!app.offers_autosave());
     app.edit_scene(|s| s.camera.fov_y_degrees = 20.0);
@@ -311,7 +319,7 @@ fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
         reference_threads: 100_000,
     };
     storage.set_string("studio", ron::to_string(&saved).unwrap());
-    let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &StudioArgs::default());
+    let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &test_args());
     assert_eq!(app.panes().count(), 2);
     let first = app.panes().list()[0].settings();
     assert!(first.problems().is_empty(), "{:?}", first.problems());
@@ -333,4 +341,64 @@ fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
     let mut harness =
         Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app);
     step_until(&mut harness, |app| app.panes().list().iter().all(|p| p.state().finished));
+}
+
+/// Step until `done` holds, for work that takes seconds (a reference).
+fn step_long_until(harness: &mut Harness<'static, StudioApp>, done: impl Fn(&StudioApp) -> bool) {
+    for _ in 0..60_000 {
+        harness.step();
+        if done(harness.state()) {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    panic!("condition not reached");
+}
+
+/// An edited scene has no reference: one is rendered in the background
+/// while the pane runs, and the pane's error becomes a figure measured
+/// against it; the finished reference is kept, so undoing the edit finds
+/// the preset's built-in reference and redoing it finds the kept one,
+/// neither rendered again.
+#[test]
+fn an_edited_scene_is_measured_against_a_reference_made_in_the_background() {
+    use gi_studio::app::{PaneError, Source};
+    let cache = tempfile::tempdir_in(env!("CARGO_TARGET_TMPDIR")).unwrap();
+    let args = StudioArgs { panes: Some(1), reference_cache: Some(cache.path().to_owned()), ..Default::default() };
+    let mut app = StudioApp::new(&egui::Context::default(), None, &args);
+    *app.panes_mut().list_mut()[0].settings_mut() = gi_studio::render::RenderSettings {
+        width: 64,
+        height: 48,
+        samples_per_pixel: None,
+        ..gi_studio::render::RenderSettings::for_algorithm(gi_studio::render::Algorithm::Path)
+    };
+    let small = |s: &mut gi_studio::scene::Scene| (s.settings.width, s.settings.height) = (64, 48);
+    app.edit_scene(small);
+    let mut harness =
+        Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app);
+    step_long_until(&mut harness, |app| matches!(app.references().source(), Some(Source::Rendering(_))));
+    harness.get_by_label_contains("path tracing");
+    step_long_until(
+        &mut harness,
+        |app| matches!(app.panes().list()[0].state().latest_error(), Some(PaneError::Measured(e)) if e.rel_mse.is_finite()),
+    );
+    harness.step();
+    harness.get_by_label_contains(" ±");
+    let finished = |app: &StudioApp| matches!(app.references().source(), Some(Source::Rendering(p)) if !p.running && p.passes == p.target);
+    step_long_until(&mut harness, finished);
+    let kept = |dir: &std::path::Path| {
+        std::fs::read_dir(dir).map_or(0, |entries| {
+            entries.filter(|e| e.as_ref().is_ok_and(|e| e.path().extension().is_some_and(|x| x == "exr"))).count()
+        })
+    };
+    step_long_until(&mut harness, |_| kept(cache.path()) == 1);
+    // Undone: the preset as shipped, its built-in reference
+    harness.state_mut().edit_scene(|s| (s.settings.width, s.settings.height) = (640, 480));
+    step_long_until(&mut harness, |app| app.references().source() == Some(&Source::BuiltIn));
+    harness.run_steps(2);
+    harness.get_by_label_contains("built in");
+    // Redone: the kept one, from the cache
+    harness.state_mut().edit_scene(small);
+    step_long_until(&mut harness, |app| app.references().source() == Some(&Source::Cache));
+    assert_eq!(kept(cache.path()), 1, "nothing rendered again");
 }

@@ -65,7 +65,8 @@ impl ScreenshotRequest {
                     repaint.request_repaint();
                 });
             }
-            ctx.request_repaint();
+            // Waiting for passes: the tiles ask for frames as they come
+            ctx.request_repaint_after(super::status::RENDER_REPAINT);
             return None;
         }
         let outcome = self.result.lock().ok().and_then(|mut slot| slot.take());
@@ -179,7 +180,8 @@ mod tests {
         let pixels: Vec<egui::Color32> =
             (0..w * h).map(|i| egui::Color32::from_rgb((i % w) as u8, (i / w) as u8, 7)).collect();
         let image = egui::ColorImage { size: [w, h], pixels, source_size: egui::vec2(w as f32, h as f32) };
-        let path = std::env::temp_dir().join(format!("gi-sheet-{}.png", std::process::id()));
+        let temp = tempfile::tempdir().unwrap();
+        let path = temp.path().join("sheet.png");
         // Points at 2 pixels per point: the rect (1, 2)–(5, 5) is pixels (2, 4)–(10, 10)
         let rect = egui::Rect::from_min_max(egui::pos2(1.0, 2.0), egui::pos2(5.0, 5.0));
         save_screenshot(&image, Some(rect), 2.0, &path).unwrap();
@@ -198,7 +200,8 @@ mod tests {
 
     #[test]
     fn screenshot_paths_are_checked_before_the_window_opens() {
-        let dir = std::env::temp_dir().join(format!("gi-shot-{}", std::process::id()));
+        let temp = tempfile::tempdir().unwrap();
+        let dir = temp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         assert!(check_screenshot_path(&dir.join("x.jpg"), false).unwrap_err().to_string().contains(".png"));
         assert!(check_screenshot_path(&dir.join("missing/x.png"), false).unwrap_err().to_string().contains("folder"));

@@ -26,8 +26,9 @@ mod viewport;
 
 pub use commands::Action;
 pub use inspector::Selection;
-pub use pane::{Pane, PaneState, PassRecord};
+pub use pane::{Pane, PaneError, PaneState, PassRecord};
 pub use panes::Panes;
+pub use references::{Progress, References, Source};
 pub use status::Messages;
 pub use storage::Persisted;
 pub use studio::StudioApp;
@@ -55,6 +56,10 @@ pub struct StudioArgs {
     /// Replace a screenshot file that GI Studio did not write.
     #[arg(long)]
     pub force: bool,
+    /// Keep references rendered for edited scenes in DIR (default:
+    /// $XDG_CACHE_HOME/gistudio/references, or ~/.cache/gistudio/references).
+    #[arg(long, value_name = "DIR")]
+    pub reference_cache: Option<PathBuf>,
 }
 
 fn parse_panes(text: &str) -> Result<usize, String> {

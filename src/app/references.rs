@@ -188,7 +188,7 @@ impl References {
         self.threads = threads;
         self.session = None;
         let repaint = self.ctx.clone();
-        let notify: crate::render::engine::Notify = Arc::new(move || repaint.request_repaint());
+        let notify: crate::render::engine::Notify = Arc::new(move |news| super::status::repaint(&repaint, news));
         self.workers = match Workers::new(threads) {
             Ok(workers) => {
                 self.session = RenderSession::new(&workers, Some(notify)).ok();

@@ -63,6 +63,8 @@ pub fn viewport_ui(
     let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
     ui.painter().image(texture.id(), rect, uv, egui::Color32::WHITE);
     let label = pane.label();
+    // Painted over the image, and told to screen readers (and tests) too
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, &label));
     let font = egui::FontId::proportional(13.0);
     let galley = ui.painter().layout_no_wrap(label, font, egui::Color32::WHITE);
     let label_rect = egui::Rect::from_min_size(rect.min, galley.size() + egui::vec2(12.0, 6.0));

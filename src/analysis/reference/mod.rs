@@ -14,7 +14,9 @@ mod method;
 pub use cache::{cache_dir, ReferenceCache};
 pub use embedded::embedded;
 pub use file::{info_path, load_info, ReferenceError};
-pub use method::{reference_method, reference_settings, reference_size, ReferenceMethod, REFERENCE_SEED};
+pub use method::{
+    reference_method, reference_settings, reference_size, ReferenceMethod, REFERENCE_PASSES, REFERENCE_SEED,
+};
 
 use serde::{Deserialize, Serialize};
 

@@ -5,16 +5,16 @@
 //! The UI thread never waits on the engine.
 
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
 
 use eframe::egui;
+
+mod drive;
 
 use super::capture::Capture;
 use super::commands::{Action, Command, Shown};
 use super::dialogs::Dialogs;
 use super::difference::Difference;
 use super::document::Document;
-use super::export::export_image;
 use super::files::DialogPurpose;
 use super::inspector::{inspector_ui, Selection};
 use super::keys::{input_commands, WindowState};
@@ -23,11 +23,11 @@ use super::panes::{pane_count, Panes};
 use super::plots::plots_ui;
 use super::references::References;
 use super::status::{FrameClock, Messages};
-use super::storage::{autosave_offer, read_state, remember, write_state, Autosave, Persisted, StateFile, StateKeeper};
+use super::storage::{autosave_offer, read_state, remember, write_state, Autosave, Persisted, StateKeeper};
 use super::StudioArgs;
 use crate::analysis::reference::ReferenceCache;
 use crate::render::Workers;
-use crate::scene::{load_scene, presets, Scene};
+use crate::scene::{presets, Scene};
 
 pub struct StudioApp {
     document: Document,
@@ -61,9 +61,13 @@ impl StudioApp {
             Ok(workers) => (Some(workers), None),
             Err(e) => (None, Some(format!("could not start the render threads: {e}"))),
         };
+        let reference_cache = match &args.reference_cache {
+            Some(dir) => Some(ReferenceCache::new(dir.clone(), crate::limits::REFERENCE_CACHE_BYTES)),
+            None => ReferenceCache::open_default(),
+        };
         let mut app = Self {
             panes: Panes::new(ctx, workers),
-            references: References::new(ctx, restored.reference_threads, ReferenceCache::open_default()),
+            references: References::new(ctx, restored.reference_threads, reference_cache),
             document,
             selection: Selection::Camera,
             dialogs: Dialogs::new(autosave_offer),
@@ -85,106 +89,6 @@ impl StudioApp {
         app.panes.build(count, &saved_panes, &restored.exposures, &app.document.scene().settings);
         app.restart_all();
         app
-    }
-
-    // ---- What the tests and the binary read and drive ------------------------
-
-    pub fn scene(&self) -> &Scene {
-        self.document.scene()
-    }
-
-    /// Edit the scene as the inspector does (a new revision).
-    pub fn edit_scene(&mut self, edit: impl FnOnce(&mut Scene)) {
-        edit(self.document.scene_mut());
-        self.document.changed();
-    }
-
-    pub fn panes(&self) -> &Panes {
-        &self.panes
-    }
-
-    pub fn panes_mut(&mut self) -> &mut Panes {
-        &mut self.panes
-    }
-
-    /// The scene's reference, wherever it comes from.
-    pub fn references(&self) -> &References {
-        &self.references
-    }
-
-    pub fn references_mut(&mut self) -> &mut References {
-        &mut self.references
-    }
-
-    pub fn selection(&self) -> Selection {
-        self.selection
-    }
-
-    /// What the status bar says: the last error (bad file, failed save…), or news.
-    pub fn messages(&self) -> &Messages {
-        &self.messages
-    }
-
-    /// Whether rendering is paused (the window is minimised).
-    pub fn is_paused(&self) -> bool {
-        self.paused
-    }
-
-    /// Whether the last session's unsaved scene is being offered back.
-    pub fn offers_autosave(&self) -> bool {
-        self.dialogs.offers_autosave()
-    }
-
-    /// The slot where a failed headless screenshot leaves its error.
-    pub fn exit_error(&self) -> Arc<Mutex<Option<String>>> {
-        self.capture.exit_error()
-    }
-
-    /// Keep the state in `file`: written every few seconds and on exit.
-    pub fn keep_state_in(&mut self, file: StateFile) {
-        self.state.keep_in(file);
-    }
-
-    /// Add a line to the status bar.
-    pub fn notice(&mut self, message: &str) {
-        self.messages.notice(message);
-    }
-
-    /// Render every pane afresh with the scene as it stands (after their
-    /// settings changed).
-    pub fn restart_all(&mut self) {
-        self.document.check();
-        if let Some(scene) = self.document.valid().cloned() {
-            self.panes.restart_all(&scene);
-            self.references.follow(&scene);
-        }
-    }
-
-    /// Make pane `index`'s image the reference.
-    pub fn promote_pane(&mut self, index: usize) {
-        let Some(pane) = self.panes.list().get(index) else { return };
-        let promoted = self.references.promote(index, pane.algorithm(), &pane.state().image);
-        self.messages.report(promoted, || format!("Pane {}'s image is the reference now", index + 1));
-    }
-
-    /// Open a scene file; a broken one leaves the scene being edited as it was.
-    pub fn open_path(&mut self, path: &Path) {
-        match load_scene(path) {
-            Ok(scene) => {
-                self.replace_scene(scene.into_scene(), Some(path.to_owned()), true);
-                remember(&mut self.recent, path);
-                self.messages.error = None;
-                self.messages.say(format!("Opened {}", path.display()));
-            }
-            Err(e) => self.messages.fail(e),
-        }
-    }
-
-    /// Save pane `index`'s current image (.png tone-mapped, .exr linear).
-    pub fn export_pane(&mut self, index: usize, path: &Path) {
-        let Some(pane) = self.panes.list().get(index) else { return };
-        let exported = export_image(&pane.state().image, pane.exposure(), path);
-        self.messages.report(exported, || format!("Exported {}", path.display()));
     }
 
     // ---- Commands ------------------------------------------------------------
@@ -303,8 +207,13 @@ impl StudioApp {
 
     /// One frame of the whole studio.
     pub fn show(&mut self, ui: &mut egui::Ui) {
+        self.show_timed(ui, None);
+    }
+
+    /// `show`, told what the previous frame cost (by eframe).
+    fn show_timed(&mut self, ui: &mut egui::Ui, previous_frame_cost: Option<f32>) {
         let ctx = ui.ctx().clone();
-        self.clock.tick();
+        self.clock.tick(previous_frame_cost);
         if let Some(message) = self.references.poll() {
             self.messages.fail(message);
         }
@@ -378,6 +287,14 @@ impl StudioApp {
             Err(e) => self.messages.fail(e),
         }
         if done.quit {
+            // What a headless run measured, for the README's figures and CI
+            if let Some(frames) = self.clock.summary() {
+                println!("{frames}");
+            }
+            for (i, pane) in self.panes.list().iter().enumerate() {
+                println!("pane {}: {}", i + 1, pane.label());
+            }
+            println!("{}", self.references.describe());
             self.quit_confirmed = true;
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
@@ -395,8 +312,8 @@ impl StudioApp {
 }
 
 impl eframe::App for StudioApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        self.show(ui);
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
+        self.show_timed(ui, frame.info().cpu_usage);
     }
 
     /// The layout and the autosave. A `--screenshot` run writes neither; while

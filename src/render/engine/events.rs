@@ -9,8 +9,10 @@ use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::integrators::PhotonPassStats;
 use crate::render::world::camera::TileRect;
 
-/// Called after events are sent (the studio passes `ctx.request_repaint`).
-pub type Notify = Arc<dyn Fn() + Send + Sync>;
+/// Called after an event is sent, with whether it is news to show at once
+/// (`RenderEvent::is_news`) or progress that may wait for the next frame
+/// (the studio passes a repaint request).
+pub type Notify = Arc<dyn Fn(bool) + Send + Sync>;
 
 #[derive(Clone, Debug)]
 pub struct TileUpdate {
@@ -67,6 +69,16 @@ impl RenderEvent {
             | RenderEvent::Finished { generation, .. }
             | RenderEvent::Failed { generation, .. } => *generation,
             RenderEvent::Tile(tile) => tile.generation,
+        }
+    }
+
+    /// Whether the event changes what a viewer should see at once (a job
+    /// started, its preview, its end), not just how far a pass has come.
+    pub fn is_news(&self) -> bool {
+        match self {
+            RenderEvent::Tile(tile) => tile.preview,
+            RenderEvent::PassFinished { .. } => false,
+            _ => true,
         }
     }
 }

@@ -57,9 +57,10 @@ impl JobContext<'_> {
     fn send(&self, event: RenderEvent) {
         // The receiver is gone only when the session was dropped, and then
         // nobody is left to tell
+        let news = event.is_news();
         let _ = self.events.send(event);
         if let Some(notify) = self.notify {
-            notify();
+            notify(news);
         }
     }
 }
