@@ -75,7 +75,8 @@ fn sppm_radii_stay_positive_over_thousands_of_passes() {
 }
 
 /// Photon mapping's bias: fixed-k photon mapping's error plateaus while
-/// SPPM's keeps falling.
+/// SPPM's keeps falling — a plateau well below a black image's error (a
+/// renderer that draws nothing plateaus too).
 #[test]
 fn photon_mapping_plateaus_while_sppm_converges() {
     let scene = presets::preset("caustics").unwrap().unwrap();
@@ -89,5 +90,8 @@ fn photon_mapping_plateaus_while_sppm_converges() {
     let (photon_early, photon_late) = (error(Algorithm::Photon, 8), error(Algorithm::Photon, 128));
     let (sppm_early, sppm_late) = (error(Algorithm::Sppm, 8), error(Algorithm::Sppm, 128));
     assert!(photon_late > 0.5 * photon_early, "photon mapping kept converging: {photon_early} → {photon_late}");
+    let black = LinearImage::new(reference.width, reference.height);
+    let black_error = rel_mse(&black, &reference, RelMseOptions::default()).unwrap();
+    assert!(photon_late < 0.1 * black_error, "photon mapping's plateau {photon_late}, a black image's {black_error}");
     assert!(sppm_late < 0.5 * sppm_early, "SPPM stalled: {sppm_early} → {sppm_late}");
 }
