@@ -139,8 +139,14 @@ fn exporting_a_pane_writes_a_png_of_the_panes_size() {
     let path =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-ui-export-{}.png", std::process::id()));
     harness.state_mut().export_pane(0, &path);
-    let decoded = image::open(&path).expect("a PNG");
+    let decoded = image::open(&path).expect("a PNG").to_rgb8();
     assert_eq!((decoded.width(), decoded.height()), (64, 48));
+    // The pane's image as shown: each pixel tone-mapped at the pane's exposure
+    let pane = &harness.state().panes().list()[0];
+    for (i, (png, linear)) in decoded.pixels().zip(&pane.state().image.pixels).enumerate() {
+        assert_eq!(png.0, gi_studio::render::image::tonemap_srgb8(*linear, pane.exposure()), "pixel {i}");
+    }
+    assert!(decoded.pixels().any(|p| p.0 != [0, 0, 0]), "a rendered image, not a black one");
 }
 
 #[test]
@@ -190,6 +196,8 @@ fn every_menu_opens_and_draws() {
 #[test]
 fn rendering_pauses_while_minimised_and_resumes_after() {
     let mut harness = studio(1);
+    harness.state_mut().panes_mut().list_mut()[0].settings_mut().samples_per_pixel = None;
+    harness.state_mut().restart_all();
     step_until(&mut harness, |app| app.panes().list()[0].state().passes() >= 1);
     let minimise = |harness: &mut Harness<'static, StudioApp>, minimised: bool| {
         harness.input_mut().viewports.entry(egui::ViewportId::ROOT).or_default().minimized = Some(minimised);
@@ -197,10 +205,19 @@ fn rendering_pauses_while_minimised_and_resumes_after() {
     };
     minimise(&mut harness, true);
     assert!(harness.state().is_paused());
+    // No pass arrives while paused (an unlimited render would add several
+    // a frame at 64×48)
+    let passes = harness.state().panes().list()[0].state().passes();
+    for _ in 0..50 {
+        harness.step();
+        std::thread::sleep(std::time::Duration::from_millis(4));
+    }
+    assert_eq!(harness.state().panes().list()[0].state().passes(), passes, "passes arrived while paused");
     let generation = harness.state().panes().generations()[0];
     minimise(&mut harness, false);
     assert!(!harness.state().is_paused());
     assert!(harness.state().panes().generations()[0] > generation, "restored: the panes render again");
+    step_until(&mut harness, |app| app.panes().list()[0].state().passes() > passes);
 }
 
 /// eframe storage in memory, as a second start would read it.
