@@ -26,7 +26,8 @@ fn render(preset: &str, spp: u32, seed: u64) -> (LinearImage, LinearImage, PassS
         ..RenderSettings::for_algorithm(Algorithm::Path)
     };
     let session = RenderSession::new(Workers::shared().unwrap(), None).unwrap();
-    let generation = session.start(RenderJob { stream_tiles: false, ..RenderJob::new(scene, settings) });
+    let generation =
+        session.start(RenderJob { stream_tiles: false, estimate_noise: true, ..RenderJob::new(scene, settings) });
     for event in session.events().iter() {
         if let RenderEvent::Finished { generation: g, image, variance, stats } = event {
             if g == generation {

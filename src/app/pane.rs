@@ -209,7 +209,8 @@ impl Pane {
     /// Abandon the current job and render `scene` afresh (never waits).
     pub fn restart(&mut self, scene: Arc<ValidScene>) {
         let Some(session) = &self.session else { return };
-        let generation = session.start(RenderJob::new(scene, self.settings.clone()));
+        let job = RenderJob { estimate_noise: true, ..RenderJob::new(scene, self.settings.clone()) };
+        let generation = session.start(job);
         self.state = PaneState::new(generation, self.settings.width, self.settings.height);
     }
 

@@ -361,6 +361,7 @@ impl References {
         let target = settings.samples_per_pixel.unwrap_or(0);
         let mut job = RenderJob::new(current.scene.clone(), settings);
         job.stream_variance = true;
+        job.estimate_noise = true;
         self.generation = session.start(job);
         self.image = LinearImage::new(width, height);
         self.variance = LinearImage::new(width, height);

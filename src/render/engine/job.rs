@@ -34,11 +34,14 @@ pub struct RenderJob {
     /// With each streamed tile, its pixels' estimated variance (a reference
     /// being made while it is used).
     pub stream_variance: bool,
+    /// Estimate the render's own relMSE (`PassStats::noise`, unbiased
+    /// methods only) now and then: what a viewer without a reference shows.
+    pub estimate_noise: bool,
 }
 
 impl RenderJob {
     pub fn new(scene: Arc<ValidScene>, settings: RenderSettings) -> Self {
-        Self { scene, settings, photon_maps: None, stream_tiles: true, stream_variance: false }
+        Self { scene, settings, photon_maps: None, stream_tiles: true, stream_variance: false, estimate_noise: false }
     }
 }
 
@@ -48,6 +51,7 @@ pub(super) struct JobContext<'a> {
     pub generation: u64,
     pub stream_tiles: bool,
     pub stream_variance: bool,
+    pub estimate_noise: bool,
     pub current: &'a AtomicU64,
     pub events: &'a Sender<RenderEvent>,
     pub notify: Option<&'a Notify>,
@@ -76,6 +80,12 @@ impl PassObserver for JobContext<'_> {
 
     fn wants_variance(&self) -> bool {
         self.stream_variance
+    }
+
+    fn wants_noise(&self, pass: u32) -> bool {
+        // Every pass at first, then every eighth: the estimate moves slowly,
+        // and on a fast pass it costs a sixth of the pass
+        self.estimate_noise && (pass < 8 || (pass + 1) % 8 == 0)
     }
 
     fn tile(&self, rect: TileRect, pixels: Vec<[f32; 3]>, variance: Option<Vec<[f32; 3]>>) {
@@ -142,7 +152,7 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
         stats.pass_time = pass_start.elapsed();
         stats.elapsed = start.elapsed();
         stats.photon = report.photon;
-        stats.noise = report.noise.estimate();
+        stats.noise = report.noise.estimate().or(stats.noise);
         context.send(RenderEvent::PassFinished { generation, stats });
     }
     let image = film.image(|tile| integrator.tile_pixels(&film, tile));

@@ -105,6 +105,7 @@ fn worker_loop(
             generation: job_generation,
             stream_tiles: job.stream_tiles,
             stream_variance: job.stream_variance,
+            estimate_noise: job.estimate_noise,
             current: &generation,
             events: &events,
             notify: notify.as_ref(),

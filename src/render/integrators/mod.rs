@@ -100,6 +100,9 @@ pub trait PassObserver: Sync {
     fn wants_tiles(&self) -> bool;
     /// Whether it wants each pixel's estimated variance with it.
     fn wants_variance(&self) -> bool;
+    /// Whether it wants the film's own relMSE estimate after pass `pass`
+    /// (counted from 0).
+    fn wants_noise(&self, pass: u32) -> bool;
     fn tile(&self, rect: TileRect, pixels: Vec<[f32; 3]>, variance: Option<Vec<[f32; 3]>>);
 }
 
@@ -206,7 +209,8 @@ impl Integrator {
                     let variance = if observer.wants_variance() { tile.variance() } else { None };
                     observer.tile(tile.rect, tile.mean(), variance);
                 }
-                (counters, tile.noise_terms())
+                let noise = if observer.wants_noise(pass) { tile.noise_terms() } else { TermSums::default() };
+                (counters, noise)
             })
             .collect();
         if !observer.is_current() {
