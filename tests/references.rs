@@ -56,14 +56,14 @@ fn reference(image: LinearImage, variance: Option<LinearImage>, spp: u32) -> Ref
 /// At 64 spp, relMSE against a rough reference, corrected for that
 /// reference's variance, is within 15% of relMSE against a 4096-spp
 /// reference: of 64 spp on lights.ron (uncorrected, twice it), of 256 on
-/// the Cornell box (uncorrected, a quarter more); and the film's own estimate of its relMSE (from
-/// its odd and even halves, no reference) is within 25% on a scene without
-/// fireflies, and errs on the side of too much on the Cornell box's
-/// (measured 1.45; it stands in only until the background reference
-/// arrives). A reference as noisy as the image is not corrected as well:
-/// its noisy r² in relMSE's denominator biases the terms (1.48 at 64
-/// against 64), which is why the studio measures against a background
-/// reference only once it has more passes than the pane.
+/// the Cornell box (uncorrected, a quarter more). At 64 against 64 the
+/// box's fireflies in the reference's r², relMSE's denominator, bias the
+/// terms (1.48), which is why the studio measures against a background
+/// reference only once it has four times the pane's passes. And the film's
+/// own estimate of its relMSE (from its odd and even halves, no reference)
+/// is within 25% on lights.ron and errs on the side of too much on the
+/// Cornell box (measured 1.45; it stands in only until the background
+/// reference arrives).
 #[test]
 fn own_noise_and_a_noisy_reference_corrected_measure_the_true_error() {
     // (preset, the rough reference's spp, what its noise adds at least, the
