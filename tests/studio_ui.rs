@@ -35,7 +35,12 @@ fn studio(panes: usize) -> Harness<'static, StudioApp> {
 
 /// Step until `done` holds (tiles arrive from the worker over several frames).
 fn step_until(harness: &mut Harness<'static, StudioApp>, done: impl Fn(&StudioApp) -> bool) {
-    for _ in 0..3000 {
+    step_frames_until(harness, 3000, done);
+}
+
+/// Step at most `frames` frames, 2 ms apart, until `done` holds.
+fn step_frames_until(harness: &mut Harness<'static, StudioApp>, frames: usize, done: impl Fn(&StudioApp) -> bool) {
+    for _ in 0..frames {
         harness.step();
         if done(harness.state()) {
             return;
@@ -362,14 +367,7 @@ fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
 
 /// Step until `done` holds, for work that takes seconds (a reference).
 fn step_long_until(harness: &mut Harness<'static, StudioApp>, done: impl Fn(&StudioApp) -> bool) {
-    for _ in 0..60_000 {
-        harness.step();
-        if done(harness.state()) {
-            return;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(2));
-    }
-    panic!("condition not reached");
+    step_frames_until(harness, 60_000, done);
 }
 
 /// An edited scene has no reference: one is rendered in the background
