@@ -33,7 +33,7 @@ pub struct FrameClock {
     last: Option<Instant>,
     interval_ms: f32,
     cost_ms: f32,
-    costs_ms: Vec<f32>,
+    costs_ms: std::collections::VecDeque<f32>,
 }
 
 impl FrameClock {
@@ -48,15 +48,15 @@ impl FrameClock {
         if let Some(ms) = previous_cost.map(|seconds| seconds * 1e3).filter(|ms| ms.is_finite()) {
             self.cost_ms = 0.9 * self.cost_ms + 0.1 * ms;
             if self.costs_ms.len() == KEPT_FRAMES {
-                self.costs_ms.remove(0);
+                self.costs_ms.pop_front();
             }
-            self.costs_ms.push(ms);
+            self.costs_ms.push_back(ms);
         }
     }
 
     /// "N UI frames: median M ms, 95th percentile P ms" (None before any).
     pub fn summary(&self) -> Option<String> {
-        let mut sorted = self.costs_ms.clone();
+        let mut sorted: Vec<f32> = self.costs_ms.iter().copied().collect();
         if sorted.is_empty() {
             return None;
         }
