@@ -4,7 +4,7 @@
 
 use super::reference::Reference;
 use crate::render::film::{TermSums, REL_MSE_EPSILON};
-use crate::render::image::{srgb_encode, tonemap_srgb8, LinearImage};
+use crate::render::image::{srgb_encode, LinearImage, Tonemap};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MetricError {
@@ -190,8 +190,8 @@ pub fn ssim(test: &LinearImage, reference: &LinearImage, exposure: f32) -> Resul
 /// the tone-mapped sRGB images: the perceived difference, 0 for identical.
 pub fn flip(test: &LinearImage, reference: &LinearImage, exposure: f32) -> Result<f64, MetricError> {
     check(test, reference)?;
-    let srgb =
-        |image: &LinearImage| -> Vec<u8> { image.pixels.iter().flat_map(|p| tonemap_srgb8(*p, exposure)).collect() };
+    let tonemap = Tonemap::new(exposure);
+    let srgb = |image: &LinearImage| -> Vec<u8> { image.pixels.iter().flat_map(|p| tonemap.pixel(*p)).collect() };
     let (width, height) = (test.width, test.height);
     let reference = nv_flip::FlipImageRgb8::with_data(width, height, &srgb(reference));
     let test = nv_flip::FlipImageRgb8::with_data(width, height, &srgb(test));

@@ -12,13 +12,17 @@ use crate::analysis::metrics::{rel_mse_against, ErrorEstimate};
 use crate::analysis::reference::{Reference, REFERENCE_PASSES};
 use crate::limits;
 use crate::render::film::NoiseEstimate;
-use crate::render::image::tonemap_srgb8;
+use crate::render::image::Tonemap;
 use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::world::camera::TileRect;
 use crate::render::{
     Algorithm, LinearImage, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers,
 };
 use crate::scene::ValidScene;
+
+/// Pixels of changed tiles a pane shows per frame at most (a 320×240
+/// pane's whole image in two frames).
+const UPLOAD_PIXELS_PER_FRAME: usize = 40_000;
 
 /// One point of a pane's convergence history.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,13 +68,17 @@ impl PaneError {
 pub struct PaneState {
     pub generation: u64,
     pub image: LinearImage,
-    /// Tiles changed since the texture was last updated.
+    /// Tiles changed since the texture last showed them, each once, oldest
+    /// first: a tile that changes again keeps its place, so every tile is
+    /// shown within a few frames however fast passes come.
     pub dirty: Vec<TileRect>,
     pub stats: Option<PassStats>,
     pub history: Vec<PassRecord>,
     pub maps: Option<PhotonMapStats>,
     pub failed: Option<String>,
     pub finished: bool,
+    /// When (seconds into the job) the error was last measured.
+    measured_at: f64,
 }
 
 impl PaneState {
@@ -84,13 +92,15 @@ impl PaneState {
             maps: None,
             failed: None,
             finished: false,
+            measured_at: 0.0,
         }
     }
 
     /// Apply one engine event. Events of any other generation (a job that
-    /// was restarted) are dropped: their tiles never reach the texture.
-    /// Returns whether anything changed.
-    pub fn apply(&mut self, event: RenderEvent, reference: Option<&Reference>) -> bool {
+    /// was restarted) are dropped: their tiles never reach the texture. A
+    /// finished pass is measured against `reference` (or by its own noise)
+    /// only if `measure`. Returns whether anything changed.
+    pub fn apply(&mut self, event: RenderEvent, reference: Option<&Reference>, measure: bool) -> bool {
         if event.generation() != self.generation {
             return false;
         }
@@ -109,27 +119,26 @@ impl PaneState {
                     let (x, y) = (rect.x + i as u32 % rect.width, rect.y + i as u32 / rect.width);
                     self.image.pixels[(y * self.image.width + x) as usize] = pixel;
                 }
-                self.dirty.push(rect);
+                if !self.dirty.contains(&rect) {
+                    self.dirty.push(rect);
+                }
             }
             RenderEvent::PhotonMaps { stats, .. } => self.maps = Some(stats),
             RenderEvent::PassFinished { stats, .. } => {
-                // A reference still converging measures the pane only with
-                // four times its passes: with fewer, the reference's noise in
-                // relMSE's denominator biases the figure (tests/references.rs),
-                // and the pane's own estimate stands in. A promoted image
-                // (no passes counted) is what the user chose.
-                let converged_enough = |r: &&Reference| {
-                    let passes = r.info.samples_per_pixel;
-                    passes == 0 || passes >= REFERENCE_PASSES.min(stats.passes.saturating_mul(4))
+                // Measured at ten points a decade of time (and at every one
+                // of the first passes): a log–log plot needs no more, and
+                // each measure costs the UI thread a pass over the image
+                let seconds = stats.elapsed.as_secs_f64();
+                let due = stats.passes <= 8 || seconds >= self.measured_at * 10f64.powf(0.1);
+                let error = if measure && due {
+                    self.measured_at = seconds;
+                    self.error(&stats, reference)
+                } else {
+                    None
                 };
-                let measured = reference.filter(converged_enough).and_then(|r| {
-                    let comparable = self.image.at_size(r.image.width, r.image.height)?;
-                    rel_mse_against(&comparable, r).ok()
-                });
-                let error = measured.map(PaneError::Measured).or(stats.noise.map(PaneError::Estimated));
                 self.history.push(PassRecord {
                     passes: stats.passes,
-                    seconds: stats.elapsed.as_secs_f64(),
+                    seconds,
                     pass_seconds: stats.pass_time.as_secs_f64(),
                     samples_per_second: stats.samples_per_second(),
                     error,
@@ -138,6 +147,13 @@ impl PaneState {
                 self.stats = Some(stats);
             }
             RenderEvent::Finished { stats, .. } => {
+                // The final image is always measured
+                if self.history.last().is_some_and(|r| r.error.is_none()) {
+                    let error = self.error(&stats, reference);
+                    if let Some(last) = self.history.last_mut() {
+                        last.error = error;
+                    }
+                }
                 self.stats = Some(stats);
                 self.finished = true;
             }
@@ -146,12 +162,32 @@ impl PaneState {
         true
     }
 
+    /// The image's error after the pass `stats` reports: measured against
+    /// `reference`, else estimated from its own noise.
+    fn error(&self, stats: &PassStats, reference: Option<&Reference>) -> Option<PaneError> {
+        // A reference still converging measures the pane only with four
+        // times its passes: with fewer, the reference's noise in relMSE's
+        // denominator biases the figure (tests/references.rs), and the
+        // pane's own estimate stands in. A promoted image (no passes
+        // counted) is what the user chose.
+        let converged_enough = |r: &&Reference| {
+            let passes = r.info.samples_per_pixel;
+            passes == 0 || passes >= REFERENCE_PASSES.min(stats.passes.saturating_mul(4))
+        };
+        let measured = reference.filter(converged_enough).and_then(|r| {
+            let comparable = self.image.at_size(r.image.width, r.image.height)?;
+            rel_mse_against(&comparable, r).ok()
+        });
+        measured.map(PaneError::Measured).or(stats.noise.map(PaneError::Estimated))
+    }
+
     pub fn passes(&self) -> u32 {
         self.stats.map_or(0, |s| s.passes)
     }
 
+    /// The error last measured (passes in between are not).
     pub fn latest_error(&self) -> Option<PaneError> {
-        self.history.last().and_then(|r| r.error)
+        self.history.iter().rev().find_map(|r| r.error)
     }
 }
 
@@ -220,29 +256,44 @@ impl Pane {
         }
     }
 
-    /// Take every waiting event without blocking.
+    /// Take every waiting event without blocking. relMSE is measured for
+    /// the newest pass among them only: a fast method finishes several
+    /// passes a frame, and measuring each on the UI thread cost frames
+    /// milliseconds apiece.
     pub fn poll(&mut self, reference: Option<&Reference>) -> bool {
         let Some(session) = &self.session else { return false };
-        let mut changed = false;
-        loop {
+        let mut events = Vec::new();
+        let disconnected = loop {
             match session.events().try_recv() {
-                Ok(event) => changed |= self.state.apply(event, reference),
-                Err(crossbeam_channel::TryRecvError::Empty) => return changed,
-                Err(crossbeam_channel::TryRecvError::Disconnected) => {
-                    self.state.failed = Some("this pane's render worker stopped".into());
-                    self.session = None;
-                    return true;
-                }
+                Ok(event) => events.push(event),
+                Err(crossbeam_channel::TryRecvError::Empty) => break false,
+                Err(crossbeam_channel::TryRecvError::Disconnected) => break true,
             }
+        };
+        let newest_pass = events.iter().rposition(|e| matches!(e, RenderEvent::PassFinished { .. }));
+        let mut changed = false;
+        for (i, event) in events.into_iter().enumerate() {
+            changed |= self.state.apply(event, reference, Some(i) == newest_pass);
         }
+        if disconnected {
+            self.state.failed = Some("this pane's render worker stopped".into());
+            self.session = None;
+            return true;
+        }
+        changed
     }
 
     /// Bring the texture up to date: only the tiles that changed are
     /// uploaded, the whole image only when the size or exposure changed.
+    /// A frame uploads at most `UPLOAD_PIXELS_PER_FRAME` of the changed
+    /// tiles' pixels and asks for another frame for the rest: a frame that
+    /// found whole passes of four panes waiting would otherwise take tens of
+    /// milliseconds.
     pub fn texture(&mut self, ctx: &egui::Context) -> &egui::TextureHandle {
         let image = &self.state.image;
         let size = [image.width as usize, image.height as usize];
         let options = egui::TextureOptions::LINEAR;
+        let tonemap = Tonemap::new(self.exposure);
         let stale = self.texture.as_ref().is_none_or(|t| t.size() != size);
         if stale {
             let rgba = image.to_rgba8(self.exposure);
@@ -252,15 +303,28 @@ impl Pane {
         }
         let texture =
             self.texture.get_or_insert_with(|| ctx.load_texture("pane", egui::ColorImage::example(), options));
-        for rect in self.state.dirty.drain(..) {
-            let mut rgb = Vec::with_capacity((rect.width * rect.height * 3) as usize);
+        let mut budget = UPLOAD_PIXELS_PER_FRAME;
+        let mut uploaded = 0;
+        for rect in &self.state.dirty {
+            if budget < rect.pixels() && uploaded > 0 {
+                break;
+            }
+            budget = budget.saturating_sub(rect.pixels());
+            uploaded += 1;
+            let mut pixels = Vec::with_capacity(rect.pixels());
             for y in rect.y..rect.y + rect.height {
-                for x in rect.x..rect.x + rect.width {
-                    rgb.extend_from_slice(&tonemap_srgb8(image.get(x, y), self.exposure));
+                let row = (y * image.width) as usize;
+                for p in &image.pixels[row + rect.x as usize..row + (rect.x + rect.width) as usize] {
+                    let [r, g, b] = tonemap.pixel(*p);
+                    pixels.push(egui::Color32::from_rgb(r, g, b));
                 }
             }
-            let tile = egui::ColorImage::from_rgb([rect.width as usize, rect.height as usize], &rgb);
+            let tile = egui::ColorImage::new([rect.width as usize, rect.height as usize], pixels);
             texture.set_partial([rect.x as usize, rect.y as usize], tile, options);
+        }
+        self.state.dirty.drain(..uploaded);
+        if !self.state.dirty.is_empty() {
+            super::status::repaint(ctx, false);
         }
         texture
     }
@@ -386,13 +450,45 @@ mod tests {
         // A restart made generation 2 current while generation 1's pass was
         // still in flight: its late tiles must be dropped.
         let mut state = PaneState::new(2, 4, 4);
-        assert!(!state.apply(tile(1, 9.0), None));
+        assert!(!state.apply(tile(1, 9.0), None, true));
         assert!(state.dirty.is_empty());
         assert!(state.image.pixels.iter().all(|p| *p == [0.0; 3]));
-        assert!(state.apply(tile(2, 0.5), None));
+        assert!(state.apply(tile(2, 0.5), None, true));
         assert_eq!(state.image.get(1, 1), [0.5; 3]);
         assert_eq!(state.dirty.len(), 1);
-        assert!(!state.apply(RenderEvent::Failed { generation: 1, message: "old".into() }, None));
+        assert!(!state.apply(RenderEvent::Failed { generation: 1, message: "old".into() }, None, true));
         assert!(state.failed.is_none());
+        // A tile shown again before the texture took it is uploaded once
+        assert!(state.apply(tile(2, 0.7), None, true));
+        assert_eq!(state.dirty.len(), 1);
+    }
+
+    /// A thousand passes over 100 s: the error is measured at every one of
+    /// the first eight, then about ten times a decade (not a thousand
+    /// times on the UI thread), at the newest pass of a poll only, and
+    /// always at the end; the label shows the last one measured.
+    #[test]
+    fn errors_are_measured_ten_times_a_decade_and_at_the_end() {
+        let mut state = PaneState::new(1, 4, 4);
+        let noise = Some(NoiseEstimate { rel_mse: 0.5, standard_error: 0.01 });
+        let stats = |passes: u32| PassStats {
+            passes,
+            elapsed: Duration::from_secs_f64(passes as f64 * 0.1),
+            noise,
+            ..PassStats::default()
+        };
+        for passes in 1..=1000 {
+            let newest_of_poll = passes % 3 == 0 || passes <= 8;
+            state.apply(RenderEvent::PassFinished { generation: 1, stats: stats(passes) }, None, newest_of_poll);
+        }
+        let measured: Vec<u32> = state.history.iter().filter(|r| r.error.is_some()).map(|r| r.passes).collect();
+        assert_eq!(measured[..8], [1, 2, 3, 4, 5, 6, 7, 8]);
+        // From 0.8 s to 100 s: 2.1 decades
+        assert!((25..=32).contains(&measured.len()), "{} measured: {measured:?}", measured.len());
+        assert!(measured[8..].iter().all(|p| p % 3 == 0), "only the newest pass of a poll");
+        assert!(state.latest_error().is_some());
+        let image = Arc::new(LinearImage::new(4, 4));
+        state.apply(RenderEvent::Finished { generation: 1, stats: stats(1000), image, variance: None }, None, true);
+        assert!(state.history.last().unwrap().error.is_some(), "the final image is measured");
     }
 }

@@ -8,6 +8,7 @@
 
 use std::sync::Arc;
 use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
 use crossbeam_channel::{Receiver, Sender};
 use eframe::egui;
@@ -63,6 +64,11 @@ struct Current {
     method: ReferenceMethod,
     reference: Option<Reference>,
     source: Source,
+    /// When the document reached this revision, and how long after it the
+    /// background reference's first own error estimate came (what a user
+    /// waits for to see an error on an edited scene).
+    followed_at: Instant,
+    first_estimate_after: Option<Duration>,
 }
 
 enum Request {
@@ -218,7 +224,17 @@ impl References {
             Ok(()) => Source::Looking,
             Err(_) => Source::Unavailable("the reference thread could not start".into()),
         };
-        self.current = Some(Current { key, scene: scene.clone(), size, method, reference: None, source });
+        let followed_at = Instant::now();
+        self.current = Some(Current {
+            key,
+            scene: scene.clone(),
+            size,
+            method,
+            reference: None,
+            source,
+            followed_at,
+            first_estimate_after: None,
+        });
         if self.store.is_none() {
             // Without the thread nothing is found: render at once
             self.render();
@@ -329,6 +345,9 @@ impl References {
                     progress.passes = stats.passes;
                     progress.seconds = stats.elapsed.as_secs_f64();
                     progress.noise = stats.noise;
+                    if stats.noise.is_some() && current.first_estimate_after.is_none() {
+                        current.first_estimate_after = Some(current.followed_at.elapsed());
+                    }
                     let reference = assembled(current, &self.image, &self.variance);
                     current.reference = reference;
                 }
@@ -410,6 +429,13 @@ impl References {
                 self.toggle();
             }
         });
+    }
+
+    /// How long after the scene's last change the background reference
+    /// gave its first own error estimate, if it has (what a headless
+    /// screenshot run reports).
+    pub fn first_estimate_after(&self) -> Option<Duration> {
+        self.current.as_ref().and_then(|c| c.first_estimate_after)
     }
 
     /// What `reference_ui` says of the reference.

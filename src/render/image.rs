@@ -82,14 +82,89 @@ pub fn srgb_encode(linear: f32) -> f32 {
 /// Non-finite input (which the engine never produces) shows as black.
 #[inline]
 pub fn tonemap_srgb8(linear: [f32; 3], exposure_stops: f32) -> [u8; 3] {
-    let scale = exposure_stops.exp2();
-    linear.map(|c| {
-        let v = c * scale;
-        if !v.is_finite() {
-            return 0;
+    Tonemap::new(exposure_stops).pixel(linear)
+}
+
+/// `tonemap_srgb8` at one exposure, for many pixels: the studio tone-maps
+/// every changed tile of four panes each frame, and `powf` per channel made
+/// the frames that took a whole pass cost tens of milliseconds.
+#[derive(Clone, Copy, Debug)]
+pub struct Tonemap {
+    scale: f32,
+}
+
+/// Buckets of [0, 1] for `SrgbTable`: fine enough that one holds at most
+/// one step of the 8-bit output (sRGB's steepest slope, 12.92·255 levels
+/// per unit, is 0.8 levels a bucket).
+const SRGB_BUCKETS: usize = 4096;
+
+/// The 8-bit sRGB code of v ∈ [0, 1] as the formula gives it, found by
+/// table: `start[b]` is the code at the start of bucket b, and `step[k]`
+/// the smallest v whose code is k + 1 (found by bisection on the formula,
+/// so the table and the formula agree exactly, tested below).
+struct SrgbTable {
+    start: [u8; SRGB_BUCKETS],
+    step: [f32; 256],
+}
+
+fn srgb8_by_formula(v: f32) -> u8 {
+    (srgb_encode(v) * 255.0 + 0.5) as u8
+}
+
+#[inline]
+fn srgb_bucket(v: f32) -> usize {
+    ((v * (SRGB_BUCKETS - 1) as f32) as usize).min(SRGB_BUCKETS - 1)
+}
+
+static SRGB_TABLE: std::sync::LazyLock<SrgbTable> = std::sync::LazyLock::new(|| {
+    let mut step = [f32::INFINITY; 256];
+    for (k, step) in step.iter_mut().enumerate().take(255) {
+        // Non-negative floats order as their bits: bisect on those
+        let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+        if srgb8_by_formula(1.0) as usize <= k {
+            continue;
         }
-        (srgb_encode(v.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8
-    })
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if srgb8_by_formula(f32::from_bits(mid)) as usize > k {
+                hi = mid;
+            } else {
+                lo = mid + 1;
+            }
+        }
+        *step = f32::from_bits(lo);
+    }
+    let mut start = [0u8; SRGB_BUCKETS];
+    for (k, &at) in step.iter().enumerate().take(255) {
+        if at.is_finite() {
+            let first = srgb_bucket(at) + 1;
+            start[first.min(SRGB_BUCKETS)..].iter_mut().for_each(|s| *s = (*s).max(k as u8 + 1));
+        }
+    }
+    SrgbTable { start, step }
+});
+
+impl Tonemap {
+    pub fn new(exposure_stops: f32) -> Self {
+        Self { scale: exposure_stops.exp2() }
+    }
+
+    #[inline]
+    pub fn pixel(&self, linear: [f32; 3]) -> [u8; 3] {
+        let table = &*SRGB_TABLE;
+        linear.map(|c| {
+            let v = c * self.scale;
+            if !v.is_finite() {
+                return 0;
+            }
+            let v = v.clamp(0.0, 1.0);
+            let mut code = table.start[srgb_bucket(v)];
+            while v >= table.step[code as usize] {
+                code += 1;
+            }
+            code
+        })
+    }
 }
 
 impl LinearImage {
@@ -103,10 +178,11 @@ impl LinearImage {
     }
 
     pub fn to_rgba8(&self, exposure_stops: f32) -> Vec<u8> {
+        let tonemap = Tonemap::new(exposure_stops);
         self.pixels
             .iter()
             .flat_map(|p| {
-                let [r, g, b] = tonemap_srgb8(*p, exposure_stops);
+                let [r, g, b] = tonemap.pixel(*p);
                 [r, g, b, 255]
             })
             .collect()
@@ -173,7 +249,8 @@ impl LinearImage {
         }
         match format {
             ImageFormat::Png => {
-                let rgb: Vec<u8> = self.pixels.iter().flat_map(|p| tonemap_srgb8(*p, exposure_stops)).collect();
+                let tonemap = Tonemap::new(exposure_stops);
+                let rgb: Vec<u8> = self.pixels.iter().flat_map(|p| tonemap.pixel(*p)).collect();
                 png_bytes(self.width, self.height, false, &rgb)
             }
             ImageFormat::Exr => {
@@ -235,6 +312,24 @@ mod tests {
         assert_eq!(tonemap_srgb8([0.0, 1.0, 0.5], 0.0), [0, 255, 188]);
         assert_eq!(tonemap_srgb8([0.25, 2.0, f32::NAN], 1.0), [188, 255, 0]);
         assert_eq!(tonemap_srgb8([-1.0, f32::INFINITY, 0.0], 0.0), [0, 0, 0]);
+    }
+
+    /// The table gives the formula's code for every float in [0, 1] at the
+    /// codes' edges (each step and its neighbours) and on a fine grid, and
+    /// each bucket holds at most one step.
+    #[test]
+    fn the_srgb_table_is_the_formula() {
+        let table = &*SRGB_TABLE;
+        let tonemap = Tonemap::new(0.0);
+        let code = |v: f32| tonemap.pixel([v; 3])[0];
+        let edges = table.step.iter().filter(|s| s.is_finite()).flat_map(|&s| [s.next_down(), s, s.next_up()]);
+        let grid = (0..=2_000_000).map(|i| i as f32 / 2_000_000.0);
+        for v in edges.chain(grid).filter(|v| (0.0..=1.0).contains(v)) {
+            assert_eq!(code(v), srgb8_by_formula(v), "at {v:e}");
+        }
+        for window in table.step[..255].windows(2) {
+            assert!(srgb_bucket(window[0]) < srgb_bucket(window[1]), "two steps in one bucket at {window:?}");
+        }
     }
 
     #[test]

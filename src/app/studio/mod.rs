@@ -295,6 +295,9 @@ impl StudioApp {
                 println!("pane {}: {}", i + 1, pane.label());
             }
             println!("{}", self.references.describe());
+            if let Some(after) = self.references.first_estimate_after() {
+                println!("reference: first own estimate {:.2} s after the scene was loaded", after.as_secs_f64());
+            }
             self.quit_confirmed = true;
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
