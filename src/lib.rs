@@ -6,6 +6,7 @@
 pub mod analysis;
 pub mod app;
 pub mod cli;
+pub mod faults;
 pub mod fileio;
 pub mod geometry;
 pub mod limits;

@@ -4,8 +4,15 @@
 mod common;
 
 use common::valid;
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Duration;
+
+use gi_studio::render::film::Film;
+use gi_studio::render::integrators::photon_map::trace::{trace_photons_until, MapKind, CHUNK};
+use gi_studio::render::integrators::{Integrator, PassObserver, Stage};
+use gi_studio::render::world::camera::{CameraModel, TileRect};
+use gi_studio::render::world::World;
 
 use gi_studio::render::{
     render_blocking, render_blocking_on, Algorithm, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers,
@@ -185,4 +192,91 @@ fn a_render_that_never_ends_does_not_hold_back_another_on_the_same_workers() {
     );
     drop(short);
     drop(endless);
+}
+
+/// A driver that abandons its job at its `after`-th tile and counts the
+/// tiles still finished after that: the work a cancel waits for.
+struct Abandoning {
+    after: usize,
+    tiles: std::sync::atomic::AtomicUsize,
+    late: std::sync::atomic::AtomicUsize,
+    asked: std::sync::atomic::AtomicUsize,
+}
+
+impl Abandoning {
+    fn new(after: usize) -> Self {
+        Self { after, tiles: 0.into(), late: 0.into(), asked: 0.into() }
+    }
+}
+
+impl PassObserver for Abandoning {
+    fn is_current(&self) -> bool {
+        self.asked.fetch_add(1, Ordering::SeqCst);
+        self.tiles.load(Ordering::SeqCst) < self.after
+    }
+    fn wants_tiles(&self) -> bool {
+        true
+    }
+    fn wants_variance(&self) -> bool {
+        false
+    }
+    fn wants_noise(&self, _pass: u32) -> bool {
+        false
+    }
+    fn tile(&self, _rect: TileRect, _pixels: Vec<[f32; 3]>, _variance: Option<Vec<[f32; 3]>>) {
+        if self.tiles.fetch_add(1, Ordering::SeqCst) >= self.after {
+            self.late.fetch_add(1, Ordering::SeqCst);
+        }
+    }
+}
+
+/// A restart answers within a bound of work, not of time: once a pass's
+/// driver says it is no longer wanted, at most one more tile a worker is
+/// finished (those already started), for every algorithm's pass; and
+/// photon tracing asks before every chunk of photons, so a cancel during a
+/// map of millions waits for one chunk a worker at most.
+#[test]
+fn a_cancel_waits_for_at_most_one_tile_or_chunk_a_worker() {
+    let workers = Workers::new(2).unwrap();
+    for algorithm in [Algorithm::Whitted, Algorithm::Path, Algorithm::Photon, Algorithm::Sppm] {
+        let job = job("cornell", algorithm, 160, 120, 1);
+        let mut settings = job.settings.clone();
+        settings.tile_size = 8; // 300 tiles: a cancel at the 20th leaves most undone
+        settings.set_photons(20_000);
+        let camera = CameraModel::new(&job.scene.camera, settings.width, settings.height);
+        let (world, visible) = World::for_view(&job.scene, &camera, settings.width, settings.height);
+        let stage = Stage { world: &world, camera: &camera, settings: &settings };
+        let mut film = Film::new(settings.width, settings.height, settings.tile_size, false);
+        let keep = Abandoning::new(usize::MAX);
+        let mut integrator = Integrator::prepare(&stage, &film, visible, None, &keep).expect("prepared");
+        let driver = Abandoning::new(20);
+        let report = workers.run(|| integrator.pass(&stage, &mut film, 0, &driver));
+        assert!(report.is_none(), "{algorithm}: an abandoned pass reports nothing");
+        let late = driver.late.load(Ordering::SeqCst);
+        assert!(late <= 1, "{algorithm}: {late} tiles finished after the cancel, on 2 workers");
+        assert!(driver.tiles.load(Ordering::SeqCst) < 40, "{algorithm}: the pass went on");
+    }
+
+    let scene = valid(presets::preset("cornell").unwrap().unwrap());
+    let world = World::new(&scene);
+    let count = 100 * CHUNK;
+    let asked = std::sync::atomic::AtomicUsize::new(0);
+    let all = trace_photons_until(&world, MapKind::Global, count, 0, 1, 8, &|| {
+        asked.fetch_add(1, Ordering::SeqCst);
+        true
+    });
+    assert!(all.is_some());
+    assert_eq!(asked.load(Ordering::SeqCst), 100, "one question a chunk");
+    // Told to stop at the fifth question: none but the chunks in flight go on
+    let asked = std::sync::atomic::AtomicUsize::new(0);
+    let traced = std::sync::atomic::AtomicUsize::new(0);
+    let stopped = workers.run(|| {
+        trace_photons_until(&world, MapKind::Global, count, 0, 1, 8, &|| {
+            let go = asked.fetch_add(1, Ordering::SeqCst) < 5;
+            traced.fetch_add(go as usize, Ordering::SeqCst);
+            go
+        })
+    });
+    assert!(stopped.is_none(), "an abandoned trace gives no map");
+    assert_eq!(traced.load(Ordering::SeqCst), 5, "only the chunks told to go on were traced");
 }

@@ -2,6 +2,9 @@
 //! for non-finite pixels.
 #![allow(dead_code)]
 
+pub mod detectors;
+pub mod stats;
+
 use std::sync::Arc;
 
 use gi_studio::render::world::rng::Sampler;

@@ -135,17 +135,15 @@ impl Integrator {
             Method::Photon(photon) => {
                 let maps = match maps {
                     Some(maps) => maps,
-                    None => Arc::new(PhotonMaps::build(
+                    None => Arc::new(PhotonMaps::build_until(
                         stage.world,
                         photon,
                         settings.seed,
                         settings.max_depth,
                         visible_radius,
-                    )),
+                        &|| observer.is_current(),
+                    )?),
                 };
-                if !observer.is_current() {
-                    return None;
-                }
                 Integrator::Photon(photon::PhotonMapping::new(maps, photon, settings.max_depth))
             }
             Method::Sppm(sppm) => Integrator::Sppm(sppm::Sppm::new(film, sppm, settings, visible_radius)),

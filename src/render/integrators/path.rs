@@ -6,6 +6,7 @@ use super::next_event::PathScope;
 use super::path_lanes::PathLanes;
 use super::Counters;
 use super::Stage;
+use crate::faults::{self, Fault};
 use crate::geometry::Ray;
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::camera::CameraTile;
@@ -105,7 +106,9 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
             if sampler.next_f32() >= survive {
                 break;
             }
-            throughput /= survive;
+            if !faults::active(Fault::RouletteUndivided) {
+                throughput /= survive;
+            }
         }
         ray = hit.surface.spawn_ray(scattered.wi);
     }

@@ -14,9 +14,10 @@ use rayon::prelude::*;
 
 use super::next_event::PathScope;
 use super::photon_map::kdtree::PhotonKdTree;
-use super::photon_map::trace::{trace_photons, MapKind};
+use super::photon_map::trace::{trace_photons_until, MapKind};
 use super::specular::{follow_specular, Emission, Landing};
 use super::{Counters, PassObserver, PassReport, Stage};
+use crate::faults::{self, Fault};
 use crate::geometry::Ray;
 use crate::render::film::Film;
 use crate::render::settings::{RenderSettings, SppmSettings};
@@ -105,7 +106,9 @@ impl Sppm {
         }
         let trace_start = Instant::now();
         let count = self.photons_per_pass;
-        let photons = trace_photons(stage.world, MapKind::Indirect, count, pass as u64, self.seed, max_depth);
+        let keep_going = || observer.is_current();
+        let (world, seed) = (stage.world, self.seed);
+        let photons = trace_photons_until(world, MapKind::Indirect, count, pass as u64, seed, max_depth, &keep_going)?;
         report.photon.photons_traced = count;
         report.photon.photons_stored = photons.len() as u64;
         let tree = PhotonKdTree::build(photons);
@@ -134,6 +137,10 @@ impl Sppm {
                 (sum, pixels.len())
             })
             .collect();
+        // Abandoned while gathering: the film has some tiles of this pass and not others
+        if !observer.is_current() {
+            return None;
+        }
         let (sum, count) = radii.iter().fold((0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
         report.photon.mean_radius = (sum / count.max(1) as f64) as f32;
         Some(report)
@@ -193,6 +200,7 @@ impl SppmPixel {
             return;
         }
         let m = found as f32;
+        let alpha = if faults::active(Fault::SppmRadiusFixed) { 1.0 } else { alpha };
         let photons = self.photons + alpha * m;
         let radius = self.radius * (photons / (self.photons + m)).sqrt();
         let shrink = (radius / self.radius).powi(2);

@@ -6,6 +6,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::Vec3;
 
+use crate::faults::{self, Fault};
 use crate::geometry::real::{Real, V3};
 use crate::geometry::Frame;
 use crate::render::world::rng::Sampler;
@@ -164,7 +165,8 @@ impl Bsdf {
             Bsdf::Lambert { albedo } => albedo * FRAC_1_PI,
             Bsdf::Phong { kd, ks, exponent } => {
                 let cos_alpha = reflect(wo, n).dot(wi).max(0.0);
-                kd * FRAC_1_PI + ks * ((exponent + 2.0) * 0.5 * FRAC_1_PI * cos_alpha.powf(exponent))
+                let lobe = ks * ((exponent + 2.0) * 0.5 * FRAC_1_PI * cos_alpha.powf(exponent));
+                kd * FRAC_1_PI + if faults::active(Fault::PhongLobeDim) { lobe * 0.97 } else { lobe }
             }
             Bsdf::BlinnPhong { kd, ks, exponent } => {
                 let h = (wo + wi).normalize();

@@ -20,6 +20,7 @@ use lights::{CapLight, LightLanes};
 use samples::{CameraSample, CameraSamples};
 
 use super::Counters;
+use crate::faults::{self, Fault};
 use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{frame_from_z, gamma, offset_origin, to_world, SurfaceHit};
 use crate::render::world::bsdf::{reflect_of, refraction_of, Bsdf, Refraction};
@@ -434,7 +435,9 @@ impl PathLanes {
             let stop = roulette.and(u.ge(survive));
             let kept = roulette.and_not(stop);
             killed = killed.or(stop);
-            st.throughput = kept.select_v(st.throughput / survive, st.throughput);
+            if !faults::active(Fault::RouletteUndivided) {
+                st.throughput = kept.select_v(st.throughput / survive, st.throughput);
+            }
         }
         let go = go.and_not(killed);
         st.origin = go.select_v(offset_origin(point, error, normal, wi), st.origin);

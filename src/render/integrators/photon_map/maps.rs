@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 
 use crate::render::integrators::photon_map::kdtree::{Neighbours, PhotonKdTree};
-use crate::render::integrators::photon_map::trace::{trace_photons, MapKind};
+use crate::render::integrators::photon_map::trace::{trace_photons_until, MapKind};
 use crate::render::world::bsdf::Bsdf;
 use crate::render::world::World;
 use crate::render::PhotonSettings;
@@ -84,10 +84,27 @@ pub fn resolve_max_radius(visible_radius: f32, settings: &PhotonSettings) -> f32
 impl PhotonMaps {
     /// Trace both maps; `visible_radius` sets the default gather radius.
     pub fn build(world: &World, settings: &PhotonSettings, seed: u64, max_depth: u32, visible_radius: f32) -> Self {
-        let build = |kind: MapKind, count: u32| -> (PhotonKdTree, MapStats) {
+        let built = Self::build_until(world, settings, seed, max_depth, visible_radius, &|| true);
+        built.expect("a build that is never abandoned")
+    }
+
+    /// `build`, asking `keep_going` before each chunk of photons (see
+    /// `trace_photons_until`) and before each tree: None once it says no.
+    pub fn build_until(
+        world: &World,
+        settings: &PhotonSettings,
+        seed: u64,
+        max_depth: u32,
+        visible_radius: f32,
+        keep_going: &(dyn Fn() -> bool + Sync),
+    ) -> Option<Self> {
+        let build = |kind: MapKind, count: u32| -> Option<(PhotonKdTree, MapStats)> {
             let start = Instant::now();
-            let photons = trace_photons(world, kind, count as u64, 0, seed, max_depth);
+            let photons = trace_photons_until(world, kind, count as u64, 0, seed, max_depth, keep_going)?;
             let trace_time = start.elapsed();
+            if !keep_going() {
+                return None;
+            }
             let start = Instant::now();
             let tree = PhotonKdTree::build(photons);
             let stats = MapStats {
@@ -98,16 +115,16 @@ impl PhotonMaps {
                 build_time: start.elapsed(),
                 depth: tree.depth() as u32,
             };
-            (tree, stats)
+            Some((tree, stats))
         };
-        let (global, global_stats) = build(MapKind::Global, settings.global_photons);
-        let (caustic, caustic_stats) = build(MapKind::Caustic, settings.caustic_photons);
-        Self {
+        let (global, global_stats) = build(MapKind::Global, settings.global_photons)?;
+        let (caustic, caustic_stats) = build(MapKind::Caustic, settings.caustic_photons)?;
+        Some(Self {
             global,
             caustic,
             stats: PhotonMapStats { global: global_stats, caustic: caustic_stats },
             max_radius: resolve_max_radius(visible_radius, settings),
-        }
+        })
     }
 }
 

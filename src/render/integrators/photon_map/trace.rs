@@ -6,6 +6,8 @@
 
 use rayon::prelude::*;
 
+use crate::faults::{self, Fault};
+
 use crate::render::integrators::photon_map::emit::{emit, emit_toward, specular_targets, EmittedPhoton, LightPicker};
 use crate::render::integrators::photon_map::record::Photon;
 use crate::render::world::bsdf::{Bsdf, Transport};
@@ -27,27 +29,46 @@ pub enum MapKind {
     All,
 }
 
-const CHUNK: u64 = 4096;
+/// Photons a task traces: the unit of work a cancel waits for at most.
+pub const CHUNK: u64 = 4096;
 /// Keeps photon streams apart from camera streams with the same indices.
 const PHOTON_SALT: u64 = 0x5eed_f07f_0000_0001;
 
 /// Trace `count` photons for `kind`; stored powers are divided by `count`.
 pub fn trace_photons(world: &World, kind: MapKind, count: u64, pass: u64, seed: u64, max_depth: u32) -> Vec<Photon> {
+    trace_photons_until(world, kind, count, pass, seed, max_depth, &|| true).unwrap_or_default()
+}
+
+/// `trace_photons`, asking `keep_going` before each chunk of photons: None
+/// once it says no, after no more than the chunks already being traced
+/// (one a worker).
+pub fn trace_photons_until(
+    world: &World,
+    kind: MapKind,
+    count: u64,
+    pass: u64,
+    seed: u64,
+    max_depth: u32,
+    keep_going: &(dyn Fn() -> bool + Sync),
+) -> Option<Vec<Photon>> {
     let picker = LightPicker::new(world);
     if picker.is_empty() || count == 0 {
-        return Vec::new();
+        return Some(Vec::new());
     }
     let targets = if kind == MapKind::Caustic { specular_targets(world) } else { Vec::new() };
     if kind == MapKind::Caustic && targets.is_empty() {
-        return Vec::new();
+        return Some(Vec::new());
     }
     let scale = 1.0 / count as f32;
     // usize: rayon splits only ranges of usize by index
     let chunks = count.div_ceil(CHUNK) as usize;
-    let per_chunk: Vec<Vec<Photon>> = (0..chunks)
+    let per_chunk: Option<Vec<Vec<Photon>>> = (0..chunks)
         .into_par_iter()
         .with_max_len(1) // balanced by chunk, as the passes are by tile
         .map(|chunk| {
+            if !keep_going() {
+                return None;
+            }
             let chunk = chunk as u64;
             let mut stored = Vec::new();
             for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(count) {
@@ -60,10 +81,10 @@ pub fn trace_photons(world: &World, kind: MapKind, count: u64, pass: u64, seed: 
                     trace_one(world, kind, photon, scale, max_depth, &mut sampler, &mut stored);
                 }
             }
-            stored
+            Some(stored)
         })
         .collect();
-    per_chunk.concat()
+    Some(per_chunk?.concat())
 }
 
 fn trace_one(
@@ -77,7 +98,7 @@ fn trace_one(
 ) {
     let EmittedPhoton { mut ray, mut power } = emitted;
     let held = world.holds(ray.origin);
-    power *= scale;
+    power *= if faults::active(Fault::PhotonPowerHigh) { scale * 1.05 } else { scale };
     let mut diffuse_bounces = 0;
     for depth in 0..max_depth {
         let Some(hit) = world.intersect_held(&ray, f32::INFINITY, held) else {

@@ -1,0 +1,218 @@
+//! Every warp and every light's sampling against the density it claims, by
+//! Pearson's χ² (Nori's and pbrt's style): directions binned in equal solid
+//! angles, points in equal areas, the expected counts integrated from the
+//! pdf, not from the sampler. Each test asks p > 1e-4 (a false alarm one run
+//! in 10 000 per test; the seeds are fixed, so a run is either right or
+//! not). A pdf off by a factor, or a warp that bunches its samples, fails.
+
+mod common;
+
+use std::f32::consts::PI;
+
+use common::stats::*;
+use common::*;
+use gi_studio::geometry::{intersect_sphere, intersect_triangle, Ray, SurfaceHit};
+use gi_studio::render::world::light::LightSource;
+use gi_studio::render::world::rng::Sampler;
+use gi_studio::render::world::sampling::*;
+use gi_studio::render::world::World;
+use gi_studio::scene::{presets, MaterialModel, Shape};
+use glam::{Vec2, Vec3};
+
+const SAMPLES: usize = 200_000;
+const LEVEL: f64 = 1e-4;
+
+fn assert_fits(what: &str, result: ChiSquare) {
+    assert!(
+        result.p_value > LEVEL,
+        "{what}: χ² {:.1} with {} dof, p = {:.2e}: the samples do not follow the pdf",
+        result.statistic,
+        result.dof,
+        result.p_value
+    );
+}
+
+/// The statistics the suite decides by, held to values from tables and
+/// closed forms.
+#[test]
+fn the_distributions_give_their_known_values() {
+    assert!((ln_gamma(5.0) - 24f64.ln()).abs() < 1e-12);
+    assert!((ln_gamma(0.5) - std::f64::consts::PI.sqrt().ln()).abs() < 1e-12);
+    // χ²: the 95% point of one degree of freedom is 3.841; with two, P = e^(−x/2)
+    assert!((chi_square_p_value(3.841_458_8, 1) - 0.05).abs() < 1e-6);
+    assert!((chi_square_p_value(7.0, 2) - (-3.5f64).exp()).abs() < 1e-12);
+    assert!((chi_square_p_value(150.0, 100) / 9.039_320_42e-4 - 1.0).abs() < 1e-6);
+    // I_0.4(2, 3) = Σ_{j=2..4} C(4,j) 0.4^j 0.6^(4−j)
+    assert!((beta_i(2.0, 3.0, 0.4) - 0.5248).abs() < 1e-12);
+    // Student's t: 2.228 at 5% two-sided with 10 dof; 12.706 with 1
+    assert!((student_t_quantile(0.05, 10.0) - 2.228_138_85).abs() < 1e-6);
+    assert!((student_t_quantile(0.05, 1.0) - 12.706_204_7).abs() < 1e-5);
+    assert!((normal_quantile(0.05) - 1.959_963_98).abs() < 1e-7);
+    assert!((normal_quantile(1e-9) - 6.109_410_2).abs() < 1e-5);
+    // Šidák: 1000 tests at family-wise 1e-3 ask 1.0005e-6 of each
+    assert!((sidak(1e-3, 1000) - 1.000_500_2e-6).abs() < 1e-12);
+}
+
+#[test]
+fn direction_warps_follow_their_pdfs() {
+    let mut s = Sampler::new(1, 0, 77);
+    let sphere = DirectionBins::sphere(16, 24);
+    let cosine =
+        sphere.test(SAMPLES, || Some(cosine_hemisphere(s.next_2d())), 8, |d| cosine_hemisphere_pdf(d.z) as f64);
+    assert_fits("cosine hemisphere", cosine);
+    let uniform = sphere.test(SAMPLES, || Some(uniform_sphere(s.next_2d())), 8, |_| 1.0 / (4.0 * PI as f64));
+    assert_fits("uniform sphere", uniform);
+
+    // Cones from a distant star's to a hemisphere's, binned over the cone
+    for one_minus_cos in [1e-5f32, 0.01, 0.3, 1.0, 2.0] {
+        let bins = DirectionBins::cone(Vec3::Z, one_minus_cos as f64, 10, 16);
+        let inside = |d: Vec3| common::stats::one_minus_cos(d) <= one_minus_cos as f64;
+        let pdf = |d: Vec3| if inside(d) { uniform_cone_pdf(one_minus_cos) as f64 } else { 0.0 };
+        let cone = bins.test(SAMPLES, || Some(uniform_cone(s.next_2d(), one_minus_cos)), 8, pdf);
+        assert_fits(&format!("cone 1 − cos = {one_minus_cos}"), cone);
+    }
+
+    // Power-cosine lobes, binned over the window holding all but 1e-3
+    for exponent in [0.0f32, 1.0, 10.0, 100.0, 2000.0] {
+        let span = 1.0 - (1e-3f64).powf(1.0 / (exponent as f64 + 1.0));
+        let bins = DirectionBins::cone(Vec3::Z, span, 10, 16);
+        let draw = || Some(power_cosine(s.next_2d(), exponent));
+        let lobe = bins.test(SAMPLES, draw, 8, |d| power_cosine_pdf(d.z, exponent) as f64);
+        assert_fits(&format!("power cosine n = {exponent}"), lobe);
+    }
+}
+
+/// Points: the concentric disk in equal-area rings and sectors, the
+/// triangle's barycentrics in its n² congruent sub-triangles.
+#[test]
+fn point_warps_are_uniform() {
+    let mut s = Sampler::new(2, 0, 78);
+    let (rings, sectors) = (12, 24);
+    let mut observed = vec![0.0; rings * sectors];
+    for _ in 0..SAMPLES {
+        let p = concentric_disk(s.next_2d());
+        let r2 = p.length_squared() as f64;
+        assert!(r2 <= 1.0 + 1e-6, "outside the disk: {p}");
+        let ring = ((r2 * rings as f64) as usize).min(rings - 1);
+        let phi = (p.y as f64).atan2(p.x as f64).rem_euclid(std::f64::consts::TAU);
+        let sector = ((phi / std::f64::consts::TAU * sectors as f64) as usize).min(sectors - 1);
+        observed[ring * sectors + sector] += 1.0;
+    }
+    let expected = vec![SAMPLES as f64 / (rings * sectors) as f64; rings * sectors];
+    assert_fits("concentric disk", chi_square(&observed, &expected));
+
+    let n = 16;
+    let mut observed = vec![0.0; n * n];
+    for _ in 0..SAMPLES {
+        let (b0, b1) = uniform_triangle(s.next_2d());
+        let b2 = 1.0 - b0 - b1;
+        assert!(b0 >= 0.0 && b1 >= 0.0 && b2 >= -1e-6, "outside the triangle: {b0} {b1}");
+        let (x, y) = (b0 as f64 * n as f64, b1 as f64 * n as f64);
+        let (i, j) = ((x as usize).min(n - 1), (y as usize).min(n - 1));
+        // Cell (i, j) of the grid holds a lower triangle and, where
+        // i + j < n − 1, an upper one: n² sub-triangles in all
+        let upper = x - i as f64 + y - j as f64 >= 1.0;
+        let index = if upper { (n * (n + 1) / 2) + cell_index(i, j, n - 1) } else { cell_index(i, j, n) };
+        observed[index.min(n * n - 1)] += 1.0;
+    }
+    let expected = vec![SAMPLES as f64 / (n * n) as f64; n * n];
+    assert_fits("uniform triangle", chi_square(&observed, &expected));
+}
+
+/// Number of cell (i, j) among those with i + j < `size` (row by row).
+fn cell_index(i: usize, j: usize, size: usize) -> usize {
+    (0..i).map(|row| size - row).sum::<usize>() + j
+}
+
+/// What `light` says of the direction `d` from `at`: its pdf where the ray
+/// meets its emitter first, 0 where it misses.
+fn light_pdf_toward(light: &LightSource, world: &World, at: Vec3, d: Vec3) -> f64 {
+    let LightSource::Area { object, .. } = light else { return 0.0 };
+    let ray = Ray::new(at, d);
+    let hit = match world.objects[*object as usize].shape {
+        gi_studio::render::world::ShapeRef::Sphere(i) => {
+            intersect_sphere(&ray, world.spheres.center(i as usize), world.spheres.radius[i as usize], f32::INFINITY)
+        }
+        gi_studio::render::world::ShapeRef::Triangle(t) => {
+            intersect_triangle(&ray, &world.triangles[t as usize].0, f32::INFINITY)
+        }
+        gi_studio::render::world::ShapeRef::Plane(_) => None,
+    };
+    hit.map_or(0.0, |hit| light.pdf(at, &hit) as f64)
+}
+
+/// Sampling `light` from the point `at` (normal `normal`) against its pdf,
+/// over a window of directions about `axis` holding the whole light; and
+/// each sample's pdf is what `pdf` says of its direction.
+fn check_light(what: &str, world: &World, light: &LightSource, at: Vec3, normal: Vec3, axis: Vec3, span: f64) {
+    let surface = SurfaceHit { t: 1.0, point: at, normal, error: 1e-6 };
+    let mut s = Sampler::new(3, 0, 79);
+    let (mut worst, mut grazing) = (0.0f64, 0);
+    let bins = DirectionBins::cone(axis, span, 12, 16);
+    let draw = || {
+        let sample = light.sample(&surface, s.next_2d())?;
+        match light_pdf_toward(light, world, at, sample.wi) {
+            // The cone's very edge: the ray grazes the sphere and misses by rounding
+            0.0 => grazing += 1,
+            claimed => worst = worst.max((sample.pdf as f64 / claimed - 1.0).abs()),
+        }
+        Some(sample.wi)
+    };
+    let result = bins.test(SAMPLES, draw, 24, |d| light_pdf_toward(light, world, at, d));
+    assert_fits(what, result);
+    assert!(worst < 1e-3, "{what}: a sample's pdf differs from the pdf of its direction by {worst:.2e}");
+    assert!(grazing < SAMPLES / 10_000, "{what}: {grazing} samples miss the light they sampled");
+}
+
+/// Each area light's sampling against its solid-angle pdf: a sphere seen
+/// from outside (sampled by the cone it subtends), a triangle (by area),
+/// and smallpt's light sphere, sampled only on its cap under the ceiling.
+#[test]
+fn area_lights_sample_their_solid_angle_pdfs() {
+    let emissive = MaterialModel::Emissive { radiance: Vec3::splat(3.0) };
+    let lights = valid(scene(
+        camera(Vec3::new(0.0, 1.0, 6.0), Vec3::ZERO),
+        vec![material("floor", lambert(0.5)), material("light", emissive)],
+        vec![
+            object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor"),
+            object("bulb", Shape::Sphere { center: Vec3::new(1.0, 3.0, -0.5), radius: 0.8 }, "light"),
+            object(
+                "panel",
+                Shape::Triangle {
+                    a: Vec3::new(-2.0, 2.0, -1.0),
+                    b: Vec3::new(-1.0, 2.5, 0.5),
+                    c: Vec3::new(-2.5, 1.5, 1.0),
+                },
+                "light",
+            ),
+        ],
+        vec![],
+    ));
+    let world = World::new(&lights);
+    let at = Vec3::new(0.2, 0.0, 0.3);
+    let (bulb, panel) = (&world.lights[0], &world.lights[1]);
+    let to_bulb = Vec3::new(1.0, 3.0, -0.5) - at;
+    let sin_max = 0.8 / to_bulb.length() as f64;
+    let window = 1.0 - (1.0 - sin_max * sin_max).sqrt() + 1e-3;
+    check_light("sphere light", &world, bulb, at, Vec3::Y, to_bulb.normalize(), window);
+    let corners = [Vec3::new(-2.0, 2.0, -1.0), Vec3::new(-1.0, 2.5, 0.5), Vec3::new(-2.5, 1.5, 1.0)];
+    let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+    let axis = (centre - at).normalize();
+    let window = 1.0 - corners.iter().map(|c| (*c - at).normalize().dot(axis) as f64).fold(1.0, f64::min) + 1e-3;
+    check_light("triangle light", &world, panel, at, Vec3::Y, axis, window);
+
+    // smallpt: its light's cap pokes 0.27 through the ceiling at y = 81.6
+    let smallpt = presets::preset("smallpt").and_then(Result::ok).expect("the smallpt preset");
+    let model = gi_studio::render::world::camera::CameraModel::new(&smallpt.camera, 64, 48);
+    let (world, _) = World::for_view(&smallpt, &model, 64, 48);
+    let light = world.lights.iter().find(|l| l.cap().is_some_and(|c| !c.is_whole())).expect("a capped light");
+    let at = Vec3::new(40.0, 0.0, 80.0);
+    let rim = Vec2::new(((600.0f32).powi(2) - (600.0f32 - 0.27).powi(2)).sqrt(), 81.6);
+    let axis = (Vec3::new(50.0, 81.6, 81.6) - at).normalize();
+    let window = {
+        let edge = Vec3::new(50.0 + rim.x * 1.02, rim.y, 81.6) - at;
+        let far = Vec3::new(50.0 - rim.x * 1.02, rim.y, 81.6) - at;
+        1.0 - (edge.normalize().dot(axis).min(far.normalize().dot(axis))) as f64
+    };
+    check_light("smallpt's capped light", &world, light, at, Vec3::Y, axis, window);
+}
