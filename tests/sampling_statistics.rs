@@ -216,3 +216,66 @@ fn area_lights_sample_their_solid_angle_pdfs() {
     };
     check_light("smallpt's capped light", &world, light, at, Vec3::Y, axis, window);
 }
+
+/// Photons leave each light carrying its intensity: per solid angle, the
+/// power of the photons a bin of directions gets is the light's
+/// intensity integrated over the bin (a point light's I, a spot light's
+/// I·cos^σ within its cone, a one-sided emitting triangle's L·A·cos θ).
+/// A weighted χ² (`DirectionBins::weighted_test`) at p > 1e-4 and their
+/// total power within 4 standard errors: photons 2% too strong, or a spot's
+/// falloff applied twice, fail it.
+#[test]
+fn photons_leave_each_light_with_its_intensity() {
+    use gi_studio::render::integrators::photon_map::emit::{emit, LightPicker};
+    let (intensity, exponent, cone) = (2.5f32, 3.0f32, 35f32.to_radians());
+    let spot_axis = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let emissive = MaterialModel::Emissive { radiance: Vec3::splat(1.5) };
+    let corners = [Vec3::new(-1.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0), Vec3::new(0.0, 2.5, 1.0)];
+    let cases = [
+        ("point", gi_studio::scene::LightKind::Point { position: Vec3::new(0.0, 1.0, 0.0) }, None),
+        (
+            "spot",
+            gi_studio::scene::LightKind::Spot {
+                position: Vec3::new(0.0, 2.0, 0.0),
+                direction: spot_axis,
+                cone_angle_degrees: cone.to_degrees(),
+                falloff_exponent: exponent,
+            },
+            None,
+        ),
+        ("triangle", gi_studio::scene::LightKind::Point { position: Vec3::ZERO }, Some(corners)),
+    ];
+    for (name, kind, triangle) in cases {
+        let mut lit = scene(
+            camera(Vec3::new(0.0, 1.0, 6.0), Vec3::ZERO),
+            vec![material("floor", lambert(0.5)), material("light", emissive.clone())],
+            vec![object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor")],
+            vec![light(name, kind, intensity)],
+        );
+        if let Some([a, b, c]) = triangle {
+            lit.lights.clear();
+            lit.objects.push(object("panel", Shape::Triangle { a, b, c }, "light"));
+        }
+        let world = World::new(&valid(lit));
+        let picker = LightPicker::new(&world);
+        let mut s = Sampler::new(4, 0, 80);
+        let draw = || emit(&world, &picker, &mut s).map(|p| (p.ray.direction, p.power.x as f64));
+        let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize();
+        let area = 0.5 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).length();
+        let (bins, density): (DirectionBins, Box<dyn Fn(Vec3) -> f64>) = match name {
+            "point" => (DirectionBins::sphere(12, 16), Box::new(|_| intensity as f64)),
+            "spot" => (
+                DirectionBins::cone(spot_axis, 1.0 - cone.cos() as f64 + 1e-3, 12, 16),
+                Box::new(|d: Vec3| {
+                    let cos = d.dot(spot_axis);
+                    if cos >= cone.cos() { (intensity * cos.powf(exponent)) as f64 } else { 0.0 }
+                }),
+            ),
+            _ => (DirectionBins::cone(normal, 1.0, 12, 16), Box::new(|d: Vec3| (1.5 * area * d.dot(normal).max(0.0)) as f64)),
+        };
+        let (result, total) = bins.weighted_test(SAMPLES, draw, 12, density);
+        assert_fits(&format!("{name} light's photons"), result);
+        // |z| < 4: a false alarm one run in 16 000
+        assert!(total.abs() < 4.0, "{name} light's photons carry {total:.1} standard errors too much power");
+    }
+}

@@ -327,3 +327,51 @@ impl DirectionBins {
         chi_square(&observed, &expected)
     }
 }
+
+impl DirectionBins {
+    /// Weighted draws (a photon's direction and power) against the
+    /// density of weight per solid angle `density`: each bin's mean weight
+    /// per draw against the density's integral over it, as z-scores with
+    /// the bin's own sample variance, summed: χ² with as many degrees of
+    /// freedom as bins that get weight (bins of one weight sample are
+    /// normal by the central limit theorem at these counts). A scale error
+    /// spreads thin over the bins: the total, the mean weight per draw
+    /// against the density's integral, is returned too, as a z-score.
+    pub fn weighted_test(
+        &self,
+        samples: usize,
+        mut draw: impl FnMut() -> Option<(Vec3, f64)>,
+        sub: usize,
+        density: impl Fn(Vec3) -> f64,
+    ) -> (ChiSquare, f64) {
+        let (mut sums, mut squares) = (vec![0.0; self.count()], vec![0.0; self.count()]);
+        let (mut total, mut total_squares) = (0.0, 0.0);
+        for _ in 0..samples {
+            if let Some((d, w)) = draw() {
+                let bin = self.bin(d);
+                sums[bin] += w;
+                squares[bin] += w * w;
+                total += w;
+                total_squares += w * w;
+            }
+        }
+        let expected = self.midpoint(2 * sub, &density);
+        let n = samples as f64;
+        let (mut statistic, mut dof) = (0.0, 0);
+        for b in 0..self.theta * self.phi {
+            let mean = sums[b] / n;
+            let variance = (squares[b] / n - mean * mean).max(0.0) / (n - 1.0);
+            if variance > 0.0 {
+                statistic += (mean - expected[b]).powi(2) / variance;
+                dof += 1;
+            } else if expected[b] > 1e-9 {
+                statistic = f64::INFINITY;
+            }
+        }
+        let dof = dof.max(1);
+        let (mean, want) = (total / n, expected.iter().sum::<f64>());
+        // A weight the same for every draw has no spread: then only rounding
+        let spread = ((total_squares / n - mean * mean).max(0.0) / (n - 1.0)).sqrt().max(1e-5 * want);
+        (ChiSquare { statistic, dof, p_value: chi_square_p_value(statistic, dof) }, (mean - want) / spread)
+    }
+}
