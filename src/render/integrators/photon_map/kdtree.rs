@@ -2,17 +2,46 @@
 //! one flat array in left-balanced heap order — children of node i at 2i+1
 //! and 2i+2, no pointers — split on the axis of largest extent, built by
 //! linear-time median selection, queried for the k nearest with a bounded
-//! max-heap on squared distances.
+//! max-heap on squared distances. Any record that carries a position and
+//! room for its split axis can be stored (`KdPoint`): photons, and the light
+//! vertices vertex merging gathers.
 
 use glam::Vec3;
 
 use crate::render::integrators::photon_map::record::Photon;
 
+/// What the tree stores: a position, and the split axis of its node.
+pub trait KdPoint: Copy + Default {
+    fn position(&self) -> Vec3;
+    fn axis(&self) -> usize;
+    fn set_axis(&mut self, axis: usize);
+}
+
+impl KdPoint for Photon {
+    #[inline]
+    fn position(&self) -> Vec3 {
+        self.position
+    }
+
+    #[inline]
+    fn axis(&self) -> usize {
+        Photon::axis(self)
+    }
+
+    #[inline]
+    fn set_axis(&mut self, axis: usize) {
+        Photon::set_axis(self, axis)
+    }
+}
+
 #[derive(Debug)]
-pub struct PhotonKdTree {
-    photons: Vec<Photon>,
+pub struct KdTree<P: KdPoint> {
+    photons: Vec<P>,
     depth: usize,
 }
+
+/// The photon map.
+pub type PhotonKdTree = KdTree<Photon>;
 
 /// Nodes in the left subtree of a left-balanced tree of `n` nodes: the last
 /// level fills from the left, so the left subtree is complete first.
@@ -27,11 +56,11 @@ fn left_subtree_size(n: usize) -> usize {
     (full - 1) / 2 + last.min(half_last)
 }
 
-impl PhotonKdTree {
+impl<P: KdPoint> KdTree<P> {
     /// Balance `photons` into a left-balanced tree in O(n log n).
-    pub fn build(mut photons: Vec<Photon>) -> Self {
+    pub fn build(mut photons: Vec<P>) -> Self {
         let n = photons.len();
-        let mut tree = vec![Photon::new(Vec3::ZERO, Vec3::Z, [0.0; 3]); n];
+        let mut tree = vec![P::default(); n];
         // (start, length, heap index): an explicit stack, no recursion
         let mut stack = Vec::with_capacity(64);
         if n > 0 {
@@ -41,12 +70,12 @@ impl PhotonKdTree {
             let segment = &mut photons[start..start + length];
             let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
             for p in segment.iter() {
-                lo = lo.min(p.position);
-                hi = hi.max(p.position);
+                lo = lo.min(p.position());
+                hi = hi.max(p.position());
             }
             let axis = (hi - lo).max_position();
             let median = left_subtree_size(length);
-            segment.select_nth_unstable_by(median, |a, b| a.position[axis].total_cmp(&b.position[axis]));
+            segment.select_nth_unstable_by(median, |a, b| a.position()[axis].total_cmp(&b.position()[axis]));
             let mut photon = segment[median];
             photon.set_axis(axis);
             tree[node] = photon;
@@ -65,7 +94,7 @@ impl PhotonKdTree {
     /// the first photon out of place) unless every split holds, since the
     /// queries prune by them: each photon lies inside the box its ancestors'
     /// splits leave it (left of a split ≤, right ≥, on that split's axis).
-    pub fn from_heap_order(photons: Vec<Photon>) -> Result<Self, usize> {
+    pub fn from_heap_order(photons: Vec<P>) -> Result<Self, usize> {
         let n = photons.len();
         // (node, lower and upper bounds from its ancestors): O(n) in all
         let mut stack = Vec::with_capacity(128);
@@ -73,7 +102,7 @@ impl PhotonKdTree {
             stack.push((0usize, Vec3::NEG_INFINITY, Vec3::INFINITY));
         }
         while let Some((node, lo, hi)) = stack.pop() {
-            let p = photons[node].position;
+            let p = photons[node].position();
             if !(p.cmpge(lo).all() && p.cmple(hi).all()) {
                 return Err(node);
             }
@@ -104,7 +133,7 @@ impl PhotonKdTree {
     }
 
     /// Heap-ordered photons; `Neighbours` indices point here.
-    pub fn photons(&self) -> &[Photon] {
+    pub fn photons(&self) -> &[P] {
         &self.photons
     }
 
@@ -112,6 +141,41 @@ impl PhotonKdTree {
         std::mem::size_of_val(self.photons.as_slice())
     }
 
+    /// Every photon with squared distance ≤ radius² (progressive photon
+    /// mapping, vertex merging).
+    pub fn for_each_within(&self, position: Vec3, radius: f32, mut f: impl FnMut(&P)) {
+        let n = self.photons.len();
+        if n == 0 || radius.is_nan() || radius < 0.0 {
+            return;
+        }
+        let bound = radius * radius;
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let mut node = stack[top] as usize;
+            loop {
+                let photon = &self.photons[node];
+                let offset = position - photon.position();
+                if offset.length_squared() <= bound {
+                    f(photon);
+                }
+                let delta = offset[photon.axis()];
+                let (near, far) = if delta < 0.0 { (2 * node + 1, 2 * node + 2) } else { (2 * node + 2, 2 * node + 1) };
+                if far < n && delta * delta <= bound {
+                    stack[top] = far as u32;
+                    top += 1;
+                }
+                if near >= n {
+                    break;
+                }
+                node = near;
+            }
+        }
+    }
+}
+
+impl PhotonKdTree {
     /// The `k` nearest photons to `position` within `max_radius` (inclusive)
     /// into `out`; with a `normal`, only photons arriving at its front side.
     /// Returns the number of nodes visited.
@@ -165,38 +229,6 @@ impl PhotonKdTree {
             }
         }
         visited
-    }
-
-    /// Every photon with squared distance ≤ radius² (progressive photon mapping).
-    pub fn for_each_within(&self, position: Vec3, radius: f32, mut f: impl FnMut(&Photon)) {
-        let n = self.photons.len();
-        if n == 0 || radius.is_nan() || radius < 0.0 {
-            return;
-        }
-        let bound = radius * radius;
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let mut node = stack[top] as usize;
-            loop {
-                let photon = &self.photons[node];
-                let offset = position - photon.position;
-                if offset.length_squared() <= bound {
-                    f(photon);
-                }
-                let delta = offset[photon.axis()];
-                let (near, far) = if delta < 0.0 { (2 * node + 1, 2 * node + 2) } else { (2 * node + 2, 2 * node + 1) };
-                if far < n && delta * delta <= bound {
-                    stack[top] = far as u32;
-                    top += 1;
-                }
-                if near >= n {
-                    break;
-                }
-                node = near;
-            }
-        }
     }
 }
 

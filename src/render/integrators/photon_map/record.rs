@@ -7,7 +7,7 @@ use std::sync::OnceLock;
 
 use glam::Vec3;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
 pub struct Photon {
     pub position: Vec3,
