@@ -224,3 +224,25 @@ fn floor_under_a_light_poking_through_the_ceiling() {
         assert!((got - expected).abs() < 0.01 * expected, "at {target}: {} vs {}", got / 25.0, expected / 25.0);
     }
 }
+
+/// A Lambert floor of albedo ρ under a white sky of radiance L: its
+/// radiance is ρ·L (the sky fills the hemisphere above, irradiance πL),
+/// found by sampling the background as a light with multiple importance
+/// sampling against the BSDF (path tracing), by sampling it alone (photon
+/// mapping and SPPM, whose photons find nothing more to carry here). Eight
+/// replicas each, a t-test of their means at 1e-4 (t₇ = 8.0).
+#[test]
+fn a_floor_under_a_white_sky_reflects_its_albedo() {
+    let (albedo, sky) = (0.6f32, 1.5f32);
+    let mut scene = floor_scene(albedo, vec![]);
+    scene.background = Vec3::splat(sky);
+    for algorithm in [Algorithm::Path, Algorithm::Photon, Algorithm::Sppm] {
+        let mut s = settings(algorithm, 24, 18, 16);
+        s.set_photons(10_000);
+        let means: Vec<f64> =
+            detectors::replicas(&scene, s, 8).iter().map(|image| mean_luminance(&image.pixels)).collect();
+        if let Err(e) = detectors::t_test(&format!("{algorithm} under a sky"), &means, (albedo * sky) as f64, 1e-4) {
+            panic!("{e}");
+        }
+    }
+}

@@ -268,10 +268,17 @@ fn photons_leave_each_light_with_its_intensity() {
                 DirectionBins::cone(spot_axis, 1.0 - cone.cos() as f64 + 1e-3, 12, 16),
                 Box::new(|d: Vec3| {
                     let cos = d.dot(spot_axis);
-                    if cos >= cone.cos() { (intensity * cos.powf(exponent)) as f64 } else { 0.0 }
+                    if cos >= cone.cos() {
+                        (intensity * cos.powf(exponent)) as f64
+                    } else {
+                        0.0
+                    }
                 }),
             ),
-            _ => (DirectionBins::cone(normal, 1.0, 12, 16), Box::new(|d: Vec3| (1.5 * area * d.dot(normal).max(0.0)) as f64)),
+            _ => (
+                DirectionBins::cone(normal, 1.0, 12, 16),
+                Box::new(|d: Vec3| (1.5 * area * d.dot(normal).max(0.0)) as f64),
+            ),
         };
         let (result, total) = bins.weighted_test(SAMPLES, draw, 12, density);
         assert_fits(&format!("{name} light's photons"), result);

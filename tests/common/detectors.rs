@@ -192,6 +192,43 @@ pub fn path_tracing_holds_the_furnace() -> Result<(), String> {
     t_test("path tracing in the furnace", &means, expected, 1e-4)
 }
 
+/// Two triangles: the quad a, b, c, d (counter-clockwise seen from its front).
+pub fn quad(name: &str, [a, b, c, d]: [Vec3; 4], material: &str) -> [gi_studio::scene::Object; 2] {
+    [
+        object(&format!("{name} 1"), Shape::Triangle { a, b, c }, material),
+        object(&format!("{name} 2"), Shape::Triangle { a, b: c, c: d }, material),
+    ]
+}
+
+/// A box of side 2 open at the top and the front, of triangles (so finite:
+/// a sky's photons leave from outside it), a diffuse ball in it, under a
+/// white sky and no other light.
+pub fn open_box_under_a_sky() -> Scene {
+    let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+    let mut objects: Vec<gi_studio::scene::Object> = [
+        quad("floor", [v(-1., 0., 1.), v(1., 0., 1.), v(1., 0., -1.), v(-1., 0., -1.)], "white"),
+        quad("back", [v(-1., 0., -1.), v(1., 0., -1.), v(1., 2., -1.), v(-1., 2., -1.)], "white"),
+        quad("left", [v(-1., 0., 1.), v(-1., 0., -1.), v(-1., 2., -1.), v(-1., 2., 1.)], "red"),
+        quad("right", [v(1., 0., -1.), v(1., 0., 1.), v(1., 2., 1.), v(1., 2., -1.)], "green"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    objects.push(object("ball", Shape::Sphere { center: v(0.2, 0.5, -0.2), radius: 0.5 }, "white"));
+    let mut sky = scene(
+        camera(v(0.0, 1.4, 4.0), v(0.0, 0.8, 0.0)),
+        vec![
+            material("white", lambert(0.7)),
+            material("red", MaterialModel::Lambert { albedo: Vec3::new(0.7, 0.2, 0.2) }),
+            material("green", MaterialModel::Lambert { albedo: Vec3::new(0.2, 0.7, 0.2) }),
+        ],
+        objects,
+        vec![],
+    );
+    sky.background = Vec3::ONE;
+    sky
+}
+
 /// A Cornell box with the mirror and glass balls made diffuse.
 pub fn diffuse_cornell() -> Scene {
     let mut scene = presets::preset("cornell").unwrap().unwrap().into_scene();

@@ -8,7 +8,7 @@ use glam::{Vec2, Vec3};
 
 use super::Counters;
 use crate::geometry::Ray;
-use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::bsdf::Bsdf;
 use crate::render::world::light::{LightSample, LightSource};
 use crate::render::world::occluders::Occluders;
 use crate::render::world::rng::Sampler;
@@ -117,30 +117,5 @@ impl<'w> PathScope<'w> {
             }
         }
         radiance
-    }
-
-    /// The background seen from `hit` through one BSDF-sampled ray, times
-    /// `throughput`: how photon mapping and SPPM get the background's light,
-    /// which no photon carries.
-    #[allow(clippy::too_many_arguments)]
-    pub fn background(
-        &self,
-        hit: &Hit,
-        wo: Vec3,
-        bsdf: &Bsdf,
-        throughput: Rgb,
-        sampler: &mut Sampler,
-        counters: &mut Counters,
-    ) -> Rgb {
-        let world = self.world;
-        if world.background == Rgb::ZERO {
-            return Rgb::ZERO;
-        }
-        let Some(s) = bsdf.sample(wo, hit.surface.normal, sampler, Transport::Radiance) else { return Rgb::ZERO };
-        counters.rays += 1;
-        match self.intersect(&hit.surface.spawn_ray(s.wi)) {
-            None => throughput * s.weight * world.background,
-            Some(_) => Rgb::ZERO,
-        }
     }
 }

@@ -11,7 +11,7 @@ use crate::geometry::Ray;
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::rng::Sampler;
-use crate::render::world::sampling::power_heuristic;
+use crate::render::world::sampling::{power_heuristic, uniform_sphere_pdf};
 use crate::render::world::World;
 use crate::scene::Rgb;
 
@@ -62,7 +62,9 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
     for depth in 0..max_depth {
         counters.rays += 1;
         let Some(hit) = scope.intersect(&ray) else {
-            radiance += throughput * world.background;
+            // The background, weighted against sampling it as a light
+            let weight = if after_delta { 1.0 } else { power_heuristic(last_pdf, pick_pdf * uniform_sphere_pdf()) };
+            radiance += throughput * world.background * weight;
             break;
         };
         let wo = -ray.direction;

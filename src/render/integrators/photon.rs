@@ -130,8 +130,6 @@ impl PhotonRenderer<'_> {
                 sum += s.weight * self.gathered(hit.surface.spawn_ray(s.wi), sampler, counters, scratch);
             }
             radiance += sum / rays as f32;
-        } else {
-            radiance += self.scope.background(hit, wo, bsdf, Rgb::ONE, sampler, counters);
         }
         radiance
     }

@@ -27,9 +27,10 @@ pub struct Landing {
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum Emission {
     /// A camera path's: found only through specular bounces, never
-    /// light-sampled, so it counts whole.
+    /// light-sampled, so it counts whole (the background's too).
     Count,
-    /// A final-gather ray's: direct light and caustics already hold it.
+    /// A final-gather ray's: direct light and caustics already hold it (the
+    /// background is a light too).
     Skip,
 }
 
@@ -50,7 +51,8 @@ pub fn follow_specular(
     for _ in 0..max_depth {
         counters.rays += 1;
         let Some(hit) = scope.intersect(&ray) else {
-            return (radiance + throughput * world.background, None);
+            let sky = if emission == Emission::Count { throughput * world.background } else { Rgb::ZERO };
+            return (radiance + sky, None);
         };
         let wo = -ray.direction;
         if emission == Emission::Count {

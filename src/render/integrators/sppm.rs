@@ -211,8 +211,9 @@ impl SppmPixel {
 }
 
 /// Trace a camera ray through specular bounces to its visible point,
-/// returning the light found on the way (emission seen through specular
-/// chains, direct light and the background at the point) and the point.
+/// returning the light found on the way (emission and the background seen
+/// through specular chains, direct light at the point, the background's
+/// among it) and the point.
 pub fn camera_pass(
     world: &World,
     ray: &Ray,
@@ -226,7 +227,6 @@ pub fn camera_pass(
     let n = hit.surface.normal;
     let facing = if wo.dot(n) < 0.0 { -n } else { n };
     radiance += throughput * scope.every_light(&hit, wo, facing, &bsdf, sampler, counters);
-    radiance += scope.background(&hit, wo, &bsdf, throughput, sampler, counters);
     let visible = VisiblePoint { point: hit.surface.point, facing, wo, bsdf, throughput };
     (radiance, Some(visible))
 }

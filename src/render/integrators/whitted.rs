@@ -16,7 +16,7 @@ use crate::geometry::Ray;
 use crate::render::integrators::Counters;
 use crate::render::world::bsdf::{reflect, refract};
 use crate::render::world::camera::CameraTile;
-use crate::render::world::light::LightSample;
+use crate::render::world::light::{LightSample, LightSource};
 use crate::render::world::rng::Sampler;
 use crate::render::world::{Hit, World};
 use crate::scene::{MaterialModel, Rgb};
@@ -138,7 +138,8 @@ fn local(
     counters: &mut Counters,
 ) -> Rgb {
     let mut total = Rgb::ZERO;
-    for light in &scope.world.lights {
+    // The background is seen by rays that escape, not as a local light
+    for light in scope.world.lights.iter().filter(|l| !matches!(l, LightSource::Background { .. })) {
         // Lights behind the surface are skipped (a NaN goes on, to be counted and dropped)
         let facing = |sample: &LightSample| {
             let cos = n.dot(sample.wi);

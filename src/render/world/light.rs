@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::sampling::{uniform_cone, uniform_cone_pdf, uniform_triangle};
+use super::sampling::{uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_sphere_pdf, uniform_triangle};
 use crate::faults::{self, Fault};
 use crate::geometry::real::{Real, V3};
 use crate::geometry::{Frame, Ray, SurfaceHit, Triangle};
@@ -90,6 +90,17 @@ impl Emitter {
         }
     }
 
+    /// Whether `point` (on the emitter) lies where it emits: on a sphere,
+    /// within its cap.
+    pub fn emits_at(&self, point: Vec3) -> bool {
+        match *self {
+            Emitter::Sphere { center, radius, cap, .. } => {
+                cap.is_whole() || ((point - center) / radius).dot(cap.frame.z) >= 1.0 - cap.one_minus_cos
+            }
+            Emitter::Triangle { .. } => true,
+        }
+    }
+
     /// Bound on the error of points computed on it.
     #[inline]
     pub fn error(&self) -> f32 {
@@ -127,6 +138,11 @@ pub enum LightSource {
         object: u32,
         radiance: Rgb,
         emitter: Emitter,
+    },
+    /// The scene's background: radiance arriving from every direction
+    /// that escapes, sampled uniformly over the sphere.
+    Background {
+        radiance: Rgb,
     },
 }
 
@@ -180,7 +196,7 @@ pub fn spot_factor(axis: Vec3, light_to_point: Vec3, cos_cone: f32, exponent: f3
 
 impl LightSource {
     pub fn is_delta(&self) -> bool {
-        !matches!(self, LightSource::Area { .. })
+        !matches!(self, LightSource::Area { .. } | LightSource::Background { .. })
     }
 
     /// Sample light arriving at `at` (a surface hit, for its offset origin).
@@ -204,6 +220,19 @@ impl LightSource {
             }
             LightSource::Directional { direction, irradiance } => {
                 Some(LightSample::delta(at.spawn_ray(-direction), f32::INFINITY, irradiance))
+            }
+            LightSource::Background { radiance } => {
+                let pdf = uniform_sphere_pdf();
+                let shadow = at.spawn_ray(uniform_sphere(u));
+                Some(LightSample {
+                    wi: shadow.direction,
+                    value: radiance / pdf,
+                    pdf,
+                    shadow,
+                    shadow_t_max: f32::INFINITY,
+                    on_triangle: None,
+                    on_sphere: None,
+                })
             }
             LightSource::Area { radiance, ref emitter, .. } => {
                 let (target, normal, error, pdf) = sample_area(emitter, p, u)?;

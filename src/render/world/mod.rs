@@ -4,6 +4,7 @@
 
 pub mod bsdf;
 pub mod camera;
+pub mod emission;
 pub(crate) mod lanes;
 pub mod light;
 pub mod occluders;
@@ -164,6 +165,10 @@ impl World {
                     world.lights.push(LightSource::Area { object: index as u32, radiance, emitter });
                 }
             }
+        }
+        // The background lights the scene from every direction
+        if scene.background.max_element() > 0.0 {
+            world.lights.push(LightSource::Background { radiance: scene.background });
         }
         let light_triangles: Vec<u32> = (world.lights.iter())
             .filter_map(|light| match light {
@@ -457,6 +462,12 @@ impl World {
             return EmitterCap::WHOLE;
         }
         EmitterCap::inside(center, radius, region, extent)
+    }
+
+    /// The region infinite lights must light (`cover`).
+    #[inline]
+    pub fn bounds(&self) -> emission::Bounds {
+        emission::Bounds { center: self.bounds_center, radius: self.bounds_radius }
     }
 
     #[inline]

@@ -226,7 +226,7 @@ fn holds_samples(light: &LightSource, region: &Region, object: u32) -> bool {
         LightSource::Point { position, .. } | LightSource::Spot { position, .. } => {
             region.holds(position.as_dvec3(), 0.0)
         }
-        LightSource::Directional { .. } => false,
+        LightSource::Directional { .. } | LightSource::Background { .. } => false,
         LightSource::Area { ref emitter, .. } => match *emitter {
             Emitter::Sphere { center, radius, cap, .. } => {
                 if cap.wall == Some(object) {

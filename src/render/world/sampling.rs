@@ -109,6 +109,12 @@ pub fn uniform_sphere(u: Vec2) -> Vec3 {
     Vec3::new(r * cos, r * sin, z)
 }
 
+/// The density of `uniform_sphere`: 1/(4π) per steradian.
+#[inline]
+pub fn uniform_sphere_pdf() -> f32 {
+    0.25 * FRAC_1_PI
+}
+
 /// Uniform direction in a cone about +z, given `1 − cos θmax` (passed as
 /// such because it cancels to nothing in f32 for small, distant lights);
 /// pdf = 1 / (2π(1 − cos θmax)).

@@ -94,6 +94,10 @@ impl PathLanes {
         if world.spheres.radius.is_empty() || !world.planes.is_empty() || !world.triangles.is_empty() {
             return None;
         }
+        // The background as a light is sampled one path at a time
+        if world.lights.iter().any(|l| matches!(l, LightSource::Background { .. })) {
+            return None;
+        }
         let s = &world.spheres;
         let wall = |i: usize| world.walls.wall_spheres.iter().find(|(j, _)| *j as usize == i).map(|(_, w)| *w);
         let spheres = (0..s.radius.len())

@@ -1,37 +1,24 @@
 //! Where photons come from: every enabled light emits in proportion to its
-//! power. Point lights uniformly over the sphere, spot lights within their
-//! cone weighted by the falloff, directional lights from a disc covering the
-//! scene, area lights from their surface with cosine-weighted directions.
+//! power (`LightSource::emit`: point lights uniformly over the sphere, spot
+//! lights within their cone weighted by the falloff, infinite lights from a
+//! disc covering the scene, area lights from their surface with
+//! cosine-weighted directions); caustic photons aim at specular objects.
 
 use std::f32::consts::PI;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 use crate::geometry::{offset_ray_origin, Frame, Ray};
-use crate::render::world::light::{spot_factor, Emitter, LightSource};
+use crate::render::world::emission::point_on_emitter;
+use crate::render::world::light::{spot_factor, LightSource};
 use crate::render::world::rng::Sampler;
-use crate::render::world::sampling::{
-    cosine_hemisphere, uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_triangle,
-};
+use crate::render::world::sampling::{uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_sphere_pdf};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::Rgb;
 
 #[inline]
 fn luminance(c: Rgb) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
-
-/// Total emitted power (W) of a light.
-pub fn light_power(world: &World, light: &LightSource) -> Rgb {
-    match *light {
-        LightSource::Point { intensity, .. } => intensity * (4.0 * PI),
-        LightSource::Spot { intensity, cos_cone, exponent, .. } => {
-            // ∫ over the cone of cos^σ θ dω = 2π (1 − cos^{σ+1} θc)/(σ + 1)
-            intensity * (2.0 * PI * (1.0 - cos_cone.powf(exponent + 1.0)) / (exponent + 1.0))
-        }
-        LightSource::Directional { irradiance, .. } => irradiance * (PI * world.bounds_radius * world.bounds_radius),
-        LightSource::Area { radiance, ref emitter, .. } => radiance * (PI * emitter.area()),
-    }
 }
 
 /// Picks lights in proportion to their power (luminance), so every photon
@@ -47,7 +34,7 @@ impl LightPicker {
         let mut cdf = Vec::with_capacity(world.lights.len());
         let mut total = 0.0;
         for light in &world.lights {
-            total += luminance(light_power(world, light)).max(0.0);
+            total += luminance(light.power(world.bounds())).max(0.0);
             cdf.push(total);
         }
         Self { cdf, total }
@@ -82,51 +69,9 @@ pub struct EmittedPhoton {
 /// Emit one photon from a power-chosen light.
 pub fn emit(world: &World, picker: &LightPicker, sampler: &mut Sampler) -> Option<EmittedPhoton> {
     let (index, pick) = picker.pick(sampler.next_f32())?;
-    let light = &world.lights[index];
     let (u1, u2) = (sampler.next_2d(), sampler.next_2d());
-    let (ray, power) = match *light {
-        LightSource::Point { position, intensity, .. } => {
-            (Ray::new(position, uniform_sphere(u1)), intensity * (4.0 * PI))
-        }
-        LightSource::Spot { position, direction, cos_cone, exponent, intensity, .. } => {
-            let one_minus_cos = 1.0 - cos_cone;
-            let d = Frame::from_z(direction).to_world(uniform_cone(u1, one_minus_cos));
-            let falloff = spot_factor(direction, d, cos_cone, exponent);
-            (Ray::new(position, d), intensity * (falloff / uniform_cone_pdf(one_minus_cos)))
-        }
-        LightSource::Directional { direction, irradiance } => {
-            let radius = world.bounds_radius;
-            let frame = Frame::from_z(direction);
-            let disc = crate::render::world::sampling::concentric_disk(u1) * radius;
-            let origin = world.bounds_center - direction * (2.0 * radius) + frame.x * disc.x + frame.y * disc.y;
-            (Ray::new(origin, direction), irradiance * (PI * radius * radius))
-        }
-        LightSource::Area { radiance, ref emitter, .. } => {
-            let (point, normal, error) = point_on_emitter(emitter, u1);
-            let d = Frame::from_z(normal).to_world(cosine_hemisphere(u2));
-            // Cosine-weighted: L cos θ / (pdf_area · cos θ/π) = π L A
-            let origin = offset_ray_origin(point, error, normal, d);
-            (Ray::new(origin, d), radiance * (PI * emitter.area()))
-        }
-    };
-    Some(EmittedPhoton { ray, power: power / pick })
-}
-
-/// A uniform point on an emitter: (point, normal, error bound).
-fn point_on_emitter(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f32) {
-    match *emitter {
-        Emitter::Sphere { center, radius, cap, .. } => {
-            // Uniform over the emitting cap (the whole sphere when 1 − cos = 2)
-            let normal =
-                if cap.is_whole() { uniform_sphere(u) } else { cap.frame.to_world(uniform_cone(u, cap.one_minus_cos)) };
-            (center + normal * radius, normal, emitter.error())
-        }
-        Emitter::Triangle { shape: ref triangle, .. } => {
-            let (b0, b1) = uniform_triangle(u);
-            let [a, b, c] = triangle.vertices;
-            (a * b0 + b * b1 + c * (1.0 - b0 - b1), triangle.normal, emitter.error())
-        }
-    }
+    let emission = world.lights[index].emit(world.bounds(), u1, u2);
+    Some(EmittedPhoton { ray: emission.ray, power: emission.power / pick })
 }
 
 /// Bounding spheres of the specular objects, the targets of caustic photons
@@ -224,6 +169,23 @@ pub fn emit_toward(
                 .map(|(_, r)| target_pick / (PI * r * r))
                 .sum();
             (Ray::new(origin, direction), irradiance / density)
+        }
+        LightSource::Background { radiance } => {
+            // A random sky direction, and a disc just covering the target across it
+            let direction = -uniform_sphere(u2);
+            let frame = Frame::from_z(direction);
+            let disc = crate::render::world::sampling::concentric_disk(u1) * target.1;
+            let origin =
+                target.0 - direction * (2.0 * world.bounds_radius.max(target.1)) + frame.x * disc.x + frame.y * disc.y;
+            let density: f32 = targets
+                .iter()
+                .filter(|(c, r)| {
+                    let offset = *c - origin;
+                    (offset - direction * offset.dot(direction)).length_squared() <= r * r
+                })
+                .map(|(_, r)| target_pick / (PI * r * r))
+                .sum();
+            (Ray::new(origin, direction), radiance / (uniform_sphere_pdf() * density))
         }
         LightSource::Area { radiance, ref emitter, .. } => {
             let (point, normal, error) = point_on_emitter(emitter, u1);
