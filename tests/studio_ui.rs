@@ -131,7 +131,7 @@ fn four_panes_show_four_algorithms() {
     let mut algorithms: Vec<_> = app.panes().list().iter().map(|p| p.algorithm()).collect();
     algorithms.dedup();
     assert_eq!(algorithms.len(), 4);
-    assert_eq!(algorithms, gi_studio::render::Algorithm::ALL.to_vec());
+    assert_eq!(algorithms, gi_studio::app::FOUR_PANES.to_vec());
     for pane in 1..=4 {
         harness.get_by_label(&format!("pane {pane}"));
     }

@@ -27,7 +27,7 @@ mod viewport;
 pub use commands::Action;
 pub use inspector::Selection;
 pub use pane::{Pane, PaneError, PaneState, PassRecord};
-pub use panes::Panes;
+pub use panes::{Panes, FOUR as FOUR_PANES};
 pub use references::{Progress, References, Source};
 pub use status::Messages;
 pub use storage::Persisted;

@@ -16,7 +16,8 @@ use crate::render::image::Tonemap;
 use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::world::camera::TileRect;
 use crate::render::{
-    Algorithm, LinearImage, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers,
+    Algorithm, LinearImage, Method, MisHeuristic, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings,
+    Workers,
 };
 use crate::scene::ValidScene;
 
@@ -380,8 +381,26 @@ impl Pane {
         ui.add(egui::DragValue::new(&mut s.max_depth).range(range(limits::MAX_DEPTH)).prefix("max depth "));
         ui.add(egui::DragValue::new(&mut s.width).range(16..=4096).prefix("width "));
         ui.add(egui::DragValue::new(&mut s.height).range(16..=4096).prefix("height "));
+        let mis_ui = |ui: &mut egui::Ui, mis: &mut MisHeuristic| {
+            ui.horizontal(|ui| {
+                ui.label("MIS");
+                ui.radio_value(mis, MisHeuristic::Power, "power");
+                ui.radio_value(mis, MisHeuristic::Balance, "balance");
+            });
+        };
         match &mut s.method {
-            Method::Whitted | Method::Path => {}
+            Method::Whitted | Method::Path | Method::LightTracing => {}
+            Method::Bdpt(b) => {
+                ui.separator();
+                mis_ui(ui, &mut b.mis);
+            }
+            Method::Bpm(m) | Method::Vcm(m) => {
+                ui.separator();
+                mis_ui(ui, &mut m.mis);
+                let radius = egui::DragValue::new(&mut m.radius).range(0.0..=1e6).speed(0.001);
+                ui.add(radius.prefix("merge radius (0: auto) "));
+                ui.add(egui::Slider::new(&mut m.alpha, 0.05..=1.0).text("α"));
+            }
             Method::Photon(p) => {
                 ui.separator();
                 let photons = range(limits::PHOTONS);

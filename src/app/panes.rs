@@ -26,11 +26,15 @@ pub struct Panes {
     ctx: egui::Context,
 }
 
+/// The four panes' algorithms at first: the thesis' three and progressive
+/// photon mapping (the bidirectional ones are a click away).
+pub const FOUR: [Algorithm; 4] = [Algorithm::Whitted, Algorithm::Path, Algorithm::Photon, Algorithm::Sppm];
+
 fn default_algorithms(count: usize) -> Vec<Algorithm> {
     match count {
         1 => vec![Algorithm::Path],
         2 => vec![Algorithm::Path, Algorithm::Whitted],
-        _ => Algorithm::ALL.to_vec(),
+        _ => FOUR.to_vec(),
     }
 }
 

@@ -11,7 +11,7 @@ pub mod render;
 use clap::{Args, Parser, Subcommand};
 
 use crate::limits;
-use crate::render::{Algorithm, Method, PhotonSettings, SppmSettings};
+use crate::render::{Algorithm, MergeSettings, Method, MisHeuristic, PhotonSettings, SppmSettings};
 
 /// The headless commands alone (the binary adds the studio's flags).
 #[derive(Debug, Parser)]
@@ -36,7 +36,7 @@ pub enum Command {
 /// Flags shared by every command that renders.
 #[derive(Debug, Args, Clone)]
 pub struct RenderFlags {
-    /// whitted, path, photon or sppm.
+    /// whitted, path, photon, sppm, lt, bdpt, bpm or vcm.
     #[arg(long = "algo", default_value = "path")]
     pub algorithm: Algorithm,
     /// Samples per pixel (passes); the default is 64 unless --time is given.
@@ -70,6 +70,8 @@ pub struct RenderFlags {
     pub photon: PhotonFlags,
     #[command(flatten)]
     pub sppm: SppmFlags,
+    #[command(flatten)]
+    pub bidir: BidirFlags,
 }
 
 /// Photon mapping's knobs; defaults as in `PhotonSettings`.
@@ -155,21 +157,68 @@ impl SppmFlags {
     }
 }
 
+/// The bidirectional methods' knobs; defaults as in `BidirSettings` and
+/// `MergeSettings`.
+#[derive(Debug, Args, Clone)]
+#[command(next_help_heading = "Bidirectional methods (--algo lt, bdpt, bpm, vcm)")]
+pub struct BidirFlags {
+    /// How strategies are weighed: power or balance (bdpt, bpm, vcm).
+    #[arg(long)]
+    pub mis: Option<MisHeuristic>,
+    /// Merge radius at the first pass (bpm, vcm; 0 = 1% of the scene's size).
+    #[arg(long, value_parser = |s: &str| limits::LENGTH.parse(s))]
+    pub merge_radius: Option<f32>,
+    /// Merge radius reduction α in (0, 1] (bpm, vcm).
+    #[arg(long, value_parser = |s: &str| limits::SPPM_ALPHA.parse(s))]
+    pub merge_alpha: Option<f32>,
+}
+
+impl BidirFlags {
+    fn given_mis(&self) -> Option<&'static str> {
+        self.mis.is_some().then_some("--mis")
+    }
+
+    fn given_merge(&self) -> Option<&'static str> {
+        [(self.merge_radius.is_some(), "--merge-radius"), (self.merge_alpha.is_some(), "--merge-alpha")]
+            .into_iter()
+            .find_map(|(given, name)| given.then_some(name))
+    }
+
+    fn given(&self) -> Option<&'static str> {
+        self.given_mis().or(self.given_merge())
+    }
+
+    pub fn apply(&self, m: &mut MergeSettings) {
+        m.mis = self.mis.unwrap_or(m.mis);
+        m.radius = self.merge_radius.unwrap_or(m.radius);
+        m.alpha = self.merge_alpha.unwrap_or(m.alpha);
+    }
+}
+
 impl RenderFlags {
     /// `algorithm` with the knobs the flags give it; a knob of another
     /// algorithm is refused, naming both.
     pub fn method(&self, algorithm: Algorithm) -> anyhow::Result<Method> {
         let mut method = Method::of(algorithm);
+        let (photon, sppm, bidir) = (&self.photon, &self.sppm, &self.bidir);
         let misplaced = match &mut method {
             Method::Photon(p) => {
-                self.photon.apply(p);
-                self.sppm.given()
+                photon.apply(p);
+                sppm.given().or(bidir.given())
             }
             Method::Sppm(p) => {
-                self.sppm.apply(p);
-                self.photon.given()
+                sppm.apply(p);
+                photon.given().or(bidir.given())
             }
-            Method::Whitted | Method::Path => self.photon.given().or(self.sppm.given()),
+            Method::Bdpt(b) => {
+                b.mis = bidir.mis.unwrap_or(b.mis);
+                photon.given().or(sppm.given()).or(bidir.given_merge())
+            }
+            Method::Bpm(m) | Method::Vcm(m) => {
+                bidir.apply(m);
+                photon.given().or(sppm.given())
+            }
+            Method::Whitted | Method::Path | Method::LightTracing => photon.given().or(sppm.given()).or(bidir.given()),
         };
         match misplaced {
             Some(flag) => anyhow::bail!("{flag} does not apply to --algo {algorithm}"),

@@ -21,4 +21,6 @@ pub use engine::{
 };
 pub use image::LinearImage;
 pub use integrators::PhotonPassStats;
-pub use settings::{Algorithm, Method, PhotonSettings, RenderSettings, SppmSettings};
+pub use settings::{
+    Algorithm, BidirSettings, MergeSettings, Method, MisHeuristic, PhotonSettings, RenderSettings, SppmSettings,
+};

@@ -13,10 +13,23 @@ pub enum Algorithm {
     Path,
     Photon,
     Sppm,
+    LightTracing,
+    Bdpt,
+    Bpm,
+    Vcm,
 }
 
 impl Algorithm {
-    pub const ALL: [Algorithm; 4] = [Algorithm::Whitted, Algorithm::Path, Algorithm::Photon, Algorithm::Sppm];
+    pub const ALL: [Algorithm; 8] = [
+        Algorithm::Whitted,
+        Algorithm::Path,
+        Algorithm::Photon,
+        Algorithm::Sppm,
+        Algorithm::LightTracing,
+        Algorithm::Bdpt,
+        Algorithm::Bpm,
+        Algorithm::Vcm,
+    ];
 
     /// The name used on the command line and in files.
     pub fn name(self) -> &'static str {
@@ -25,6 +38,10 @@ impl Algorithm {
             Algorithm::Path => "path",
             Algorithm::Photon => "photon",
             Algorithm::Sppm => "sppm",
+            Algorithm::LightTracing => "lt",
+            Algorithm::Bdpt => "bdpt",
+            Algorithm::Bpm => "bpm",
+            Algorithm::Vcm => "vcm",
         }
     }
 
@@ -34,6 +51,10 @@ impl Algorithm {
             Algorithm::Path => "Path tracing",
             Algorithm::Photon => "Photon mapping",
             Algorithm::Sppm => "Progressive photon mapping",
+            Algorithm::LightTracing => "Light tracing",
+            Algorithm::Bdpt => "Bidirectional path tracing",
+            Algorithm::Bpm => "Bidirectional photon mapping",
+            Algorithm::Vcm => "Vertex connection and merging",
         }
     }
 
@@ -41,7 +62,7 @@ impl Algorithm {
     /// converged image: then the spread between them is its error, and the
     /// film keeps its odd passes apart to measure it.
     pub fn is_unbiased(self) -> bool {
-        self == Algorithm::Path
+        matches!(self, Algorithm::Path | Algorithm::LightTracing | Algorithm::Bdpt)
     }
 
     /// The thesis' depth 5 for Whitted; the Monte Carlo methods end paths by
@@ -63,10 +84,10 @@ impl fmt::Display for Algorithm {
 impl FromStr for Algorithm {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Algorithm::ALL
-            .into_iter()
-            .find(|a| a.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown algorithm \"{s}\" (expected whitted, path, photon or sppm)"))
+        Algorithm::ALL.into_iter().find(|a| a.name().eq_ignore_ascii_case(s)).ok_or_else(|| {
+            let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
+            format!("unknown algorithm \"{s}\" (expected {})", names.join(", "))
+        })
     }
 }
 
@@ -77,6 +98,10 @@ pub enum Method {
     Path,
     Photon(PhotonSettings),
     Sppm(SppmSettings),
+    LightTracing,
+    Bdpt(BidirSettings),
+    Bpm(MergeSettings),
+    Vcm(MergeSettings),
 }
 
 impl Method {
@@ -86,6 +111,10 @@ impl Method {
             Method::Path => Algorithm::Path,
             Method::Photon(_) => Algorithm::Photon,
             Method::Sppm(_) => Algorithm::Sppm,
+            Method::LightTracing => Algorithm::LightTracing,
+            Method::Bdpt(_) => Algorithm::Bdpt,
+            Method::Bpm(_) => Algorithm::Bpm,
+            Method::Vcm(_) => Algorithm::Vcm,
         }
     }
 
@@ -96,7 +125,68 @@ impl Method {
             Algorithm::Path => Method::Path,
             Algorithm::Photon => Method::Photon(PhotonSettings::default()),
             Algorithm::Sppm => Method::Sppm(SppmSettings::default()),
+            Algorithm::LightTracing => Method::LightTracing,
+            Algorithm::Bdpt => Method::Bdpt(BidirSettings::default()),
+            Algorithm::Bpm => Method::Bpm(MergeSettings::default()),
+            Algorithm::Vcm => Method::Vcm(MergeSettings::default()),
         }
+    }
+}
+
+/// How bidirectional methods weigh their strategies against each other
+/// (multiple importance sampling).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum MisHeuristic {
+    /// Veach's power heuristic, β = 2: less noise where one strategy is
+    /// much better than the rest.
+    #[default]
+    Power,
+    /// The balance heuristic, β = 1.
+    Balance,
+}
+
+impl MisHeuristic {
+    pub fn name(self) -> &'static str {
+        match self {
+            MisHeuristic::Power => "power",
+            MisHeuristic::Balance => "balance",
+        }
+    }
+}
+
+impl FromStr for MisHeuristic {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "power" => Ok(MisHeuristic::Power),
+            "balance" => Ok(MisHeuristic::Balance),
+            _ => Err(format!("unknown heuristic \"{s}\" (expected power or balance)")),
+        }
+    }
+}
+
+/// Bidirectional path tracing: every connection of a light subpath to a
+/// camera subpath, weighed by `mis`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct BidirSettings {
+    pub mis: MisHeuristic,
+}
+
+/// Vertex merging (bidirectional photon mapping, and VCM's merges): the
+/// merge radius at the first pass (0: 1% of what the camera sees), which
+/// shrinks as pass^−(1−α)/2.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct MergeSettings {
+    pub mis: MisHeuristic,
+    pub radius: f32,
+    pub alpha: f32,
+}
+
+impl Default for MergeSettings {
+    fn default() -> Self {
+        Self { mis: MisHeuristic::Power, radius: 0.0, alpha: 0.75 }
     }
 }
 
@@ -195,7 +285,7 @@ impl RenderSettings {
         match &mut self.method {
             Method::Photon(p) => (p.global_photons, p.caustic_photons) = (count, count),
             Method::Sppm(p) => p.photons_per_pass = count,
-            Method::Whitted | Method::Path => {}
+            _ => {}
         }
     }
 
@@ -249,7 +339,11 @@ impl RenderSettings {
         check("firefly_clamp", ok(limits::LENGTH.check(self.firefly_clamp)));
         check("tile_size", ok(limits::TILE_SIZE.check(self.tile_size)));
         match &self.method {
-            Method::Whitted | Method::Path => {}
+            Method::Whitted | Method::Path | Method::LightTracing | Method::Bdpt(_) => {}
+            Method::Bpm(m) | Method::Vcm(m) => {
+                check("merge radius", ok(limits::LENGTH.check(m.radius)));
+                check("merge alpha", ok(limits::SPPM_ALPHA.check(m.alpha)));
+            }
             Method::Photon(p) => {
                 check("global_photons", ok(limits::PHOTONS.check(p.global_photons)));
                 check("caustic_photons", ok(limits::PHOTONS.check(p.caustic_photons)));

@@ -5,6 +5,7 @@ use std::time::Duration;
 
 use crate::render::film::NoiseEstimate;
 use crate::render::image::LinearImage;
+use crate::render::integrators::bidir::PathPassStats;
 use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::integrators::PhotonPassStats;
 use crate::render::world::camera::TileRect;
@@ -97,6 +98,8 @@ pub struct PassStats {
     pub non_finite: u64,
     /// Photon work of the last pass (photon mapping and SPPM).
     pub photon: PhotonPassStats,
+    /// Bidirectional work of the last pass.
+    pub paths: PathPassStats,
     /// The image's relMSE against the converged image it tends to, from its
     /// own noise: for unbiased methods after two passes.
     pub noise: Option<NoiseEstimate>,

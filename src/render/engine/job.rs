@@ -152,6 +152,7 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
         stats.pass_time = pass_start.elapsed();
         stats.elapsed = start.elapsed();
         stats.photon = report.photon;
+        stats.paths = report.paths;
         stats.noise = report.noise.estimate().or(stats.noise);
         context.send(RenderEvent::PassFinished { generation, stats });
     }

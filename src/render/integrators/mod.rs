@@ -4,6 +4,7 @@
 //! a tile looks like now. What they share is written once: next-event
 //! estimation (`next_event`), BSDFs, occlusion and the lanes (`world`).
 
+pub mod bidir;
 pub mod next_event;
 pub mod path;
 pub mod path_lanes;
@@ -32,6 +33,12 @@ pub struct Counters {
     pub rays: u64,
     pub non_finite: u64,
     pub queries: QueryStats,
+    /// Bidirectional methods: light subpath vertices made, connections
+    /// traced (to the camera, to lights, between vertices) and light
+    /// vertices merged.
+    pub light_vertices: u64,
+    pub connections: u64,
+    pub merges: u64,
 }
 
 impl Counters {
@@ -39,6 +46,9 @@ impl Counters {
         self.rays += other.rays;
         self.non_finite += other.non_finite;
         self.queries.add(&other.queries);
+        self.light_vertices += other.light_vertices;
+        self.connections += other.connections;
+        self.merges += other.merges;
     }
 }
 
@@ -60,6 +70,7 @@ pub struct PhotonPassStats {
 pub struct PassReport {
     pub counters: Counters,
     pub photon: PhotonPassStats,
+    pub paths: bidir::PathPassStats,
     /// The terms of the estimate's own relMSE, where the film keeps halves.
     pub noise: TermSums,
 }
@@ -115,6 +126,8 @@ pub enum Integrator {
     Path(path::PathTracer),
     Photon(photon::PhotonMapping),
     Sppm(sppm::Sppm),
+    /// Light tracing, BDPT, bidirectional photon mapping and VCM.
+    Bidir(bidir::Bidir),
 }
 
 impl Integrator {
@@ -147,6 +160,9 @@ impl Integrator {
                 Integrator::Photon(photon::PhotonMapping::new(maps, photon, settings.max_depth))
             }
             Method::Sppm(sppm) => Integrator::Sppm(sppm::Sppm::new(film, sppm, settings, visible_radius)),
+            Method::LightTracing | Method::Bdpt(_) | Method::Bpm(_) | Method::Vcm(_) => {
+                Integrator::Bidir(bidir::Bidir::new(stage.world, settings, visible_radius))
+            }
         })
     }
 
@@ -168,6 +184,7 @@ impl Integrator {
     ) -> Option<PassReport> {
         match self {
             Integrator::Sppm(sppm) => sppm.pass(stage, film, pass, observer),
+            Integrator::Bidir(bidir) => bidir.pass(stage, film, pass, observer),
             _ => self.sample_pass(stage, film, pass, observer),
         }
     }
@@ -230,7 +247,7 @@ impl Integrator {
             Integrator::Whitted(whitted) => whitted.render_tile(stage, &camera_tile, &mut values, counters),
             Integrator::Path(path) => path.render_tile(stage, &camera_tile, &mut values, counters),
             Integrator::Photon(photon) => photon.render_tile(stage, &camera_tile, &mut values, counters),
-            Integrator::Sppm(_) => unreachable!("SPPM renders its own passes"),
+            Integrator::Sppm(_) | Integrator::Bidir(_) => unreachable!("they render their own passes"),
         }
         for (i, value) in values.into_iter().enumerate() {
             tile.add(i, stage.accept(value, counters).unwrap_or(Rgb::ZERO));
@@ -260,6 +277,10 @@ impl Integrator {
                     }
                     // SPPM has no estimate before its first pass: show direct light
                     Integrator::Sppm(sppm) => sppm.direct(stage.world, &ray, sampler, &mut counters),
+                    // A bidirectional pass has no tile of its own: a path-traced one
+                    Integrator::Bidir(_) => {
+                        path::radiance(stage.world, &ray, stage.settings.max_depth, sampler, &mut counters)
+                    }
                 };
                 let value = stage.accept(value, &mut counters).unwrap_or(Rgb::ZERO);
                 for y in by..by + h {

@@ -144,6 +144,21 @@ impl Bsdf {
         matches!(self, Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::Black)
     }
 
+    /// The chance a path goes on after this surface under Russian roulette,
+    /// as bidirectional methods play it: the surface's largest reflectance
+    /// (at most 1), the same whichever way the path runs, so a subpath's
+    /// density read backwards holds it too.
+    #[inline]
+    pub fn continuation(&self) -> f32 {
+        let reflectance = match *self {
+            Bsdf::Lambert { albedo } => albedo,
+            Bsdf::Phong { kd, ks, .. } | Bsdf::BlinnPhong { kd, ks, .. } => kd + ks,
+            Bsdf::Mirror { tint } | Bsdf::Glass { tint, .. } => tint,
+            Bsdf::Black => Rgb::ZERO,
+        };
+        reflectance.max_element().min(1.0)
+    }
+
     /// Probability of choosing the diffuse lobe of a Phong-like BRDF.
     #[inline]
     fn diffuse_probability(kd: Rgb, ks: Rgb) -> f32 {

@@ -134,6 +134,67 @@ impl CameraModel {
         Some(Vec2::new((sx + 1.0) * 0.5 * self.width, (1.0 - sy) * 0.5 * self.height))
     }
 
+    /// The density of the camera's rays along `direction` from the lens,
+    /// per solid angle and per pixel: a pixel samples the image plane at
+    /// unit depth uniformly over its area A, and dA = cos³θ dω there, so
+    /// 1/(A cos³θ) (0 behind the camera).
+    #[inline]
+    pub fn ray_pdf(&self, direction: Vec3) -> f32 {
+        let cos = direction.dot(self.forward);
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        1.0 / (self.pixel_size.x * self.pixel_size.y * cos * cos * cos)
+    }
+
+    /// How far from the lens a camera ray along `direction` starts (the
+    /// near clip, along the ray or the view axis).
+    #[inline]
+    pub fn clip_distance(&self, direction: Vec3) -> f32 {
+        if self.clip_along_ray {
+            self.near_clip
+        } else {
+            self.near_clip / direction.dot(self.forward)
+        }
+    }
+
+    /// How `point` is seen from the lens point `lens` picks (a pinhole: its
+    /// position), for paths from the lights: the film position it lands on,
+    /// the way to the lens, and the density of the camera's ray there. None
+    /// if it lands off the film, behind the camera, or before the near clip.
+    pub fn connect(&self, point: Vec3, lens: Vec2) -> Option<CameraConnection> {
+        let on_lens = if self.aperture_radius > 0.0 {
+            let l = concentric_disk(lens) * self.aperture_radius;
+            self.position + self.right * l.x + self.up * l.y
+        } else {
+            self.position
+        };
+        let to_point = point - on_lens;
+        let distance = to_point.length();
+        let direction = to_point / distance;
+        let cos = direction.dot(self.forward);
+        if cos <= 0.0 || !distance.is_finite() {
+            return None;
+        }
+        // A lens images the point where its ray through the lens centre
+        // crosses the focus plane
+        let imaged = if self.aperture_radius > 0.0 { on_lens + direction * (self.focus_distance / cos) } else { point };
+        let film = self.project(imaged)?;
+        if !(film.x >= 0.0 && film.x < self.width && film.y >= 0.0 && film.y < self.height) {
+            return None;
+        }
+        let start = self.clip_distance(direction);
+        (distance > start).then(|| CameraConnection {
+            film,
+            pixel: (film.x as u32, film.y as u32),
+            lens: on_lens,
+            start,
+            distance,
+            to_camera: -direction,
+            ray_pdf: self.ray_pdf(direction),
+        })
+    }
+
     /// Where the central ray starts: the middle of the near-clip rectangle
     /// (the lens centre when there is no near clip).
     pub fn central_origin(&self) -> Vec3 {
@@ -145,6 +206,24 @@ impl CameraModel {
         let saved = Self { aperture_radius: 0.0, ..self.clone() };
         saved.generate_ray(Vec2::new(x, y), Vec2::splat(0.5))
     }
+}
+
+/// A point as the camera sees it (`CameraModel::connect`).
+#[derive(Clone, Copy, Debug)]
+pub struct CameraConnection {
+    /// Film position, in pixels (y down), and the pixel that holds it.
+    pub film: Vec2,
+    pub pixel: (u32, u32),
+    /// The point on the lens the connection goes to.
+    pub lens: Vec3,
+    /// How far from the lens along the ray camera rays start (the near clip).
+    pub start: f32,
+    /// From the lens point to the point.
+    pub distance: f32,
+    /// Unit direction from the point toward the lens.
+    pub to_camera: Vec3,
+    /// `CameraModel::ray_pdf` of the ray from the lens to the point.
+    pub ray_pdf: f32,
 }
 
 /// A rectangle of the image: what one task of a pass renders.
@@ -262,6 +341,53 @@ mod tests {
                 model.central_origin()
             );
         }
+    }
+
+    /// A light path reaches the film where the camera's ray to its point
+    /// came from, with or without a lens and a near clip, and the density
+    /// of that ray integrates to one pixel's worth over the image: Σ over
+    /// pixels of ∫ pdf dω = pixels (checked at the pixel centres, where
+    /// ∫_pixel pdf dω = 1 exactly: dω = cos³θ dA).
+    #[test]
+    fn connecting_a_point_inverts_the_camera_ray_through_it() {
+        for (aperture, clip, along) in
+            [(0.0, 0.0, ClipAlong::ViewAxis), (0.4, 2.0, ClipAlong::Ray), (0.0, 1.5, ClipAlong::ViewAxis)]
+        {
+            let cam = Camera { aperture_radius: aperture, near_clip: clip, near_clip_along: along, ..camera() };
+            let model = CameraModel::new(&cam, 64, 48);
+            let mut s = Sampler::new(1, 2, 3);
+            for _ in 0..1000 {
+                let (film, lens) = (Vec2::new(s.next_f32() * 64.0, s.next_f32() * 48.0), s.next_2d());
+                let ray = model.generate_ray(film, lens);
+                let point = ray.at(1.0 + 6.0 * s.next_f32());
+                let seen = model.connect(point, lens).expect("in view");
+                assert!((seen.film - film).length() < 2e-3, "{} vs {film}", seen.film);
+                assert!((seen.to_camera + ray.direction).length() < 1e-4);
+                assert!(((seen.lens + (-seen.to_camera) * seen.start) - ray.origin).length() < 1e-4);
+            }
+            // Before the near clip nothing is seen
+            if clip > 0.0 {
+                assert!(model.connect(model.position + model.forward * clip * 0.5, Vec2::splat(0.5)).is_none());
+            }
+        }
+        // The solid angle of a pixel, exactly (Van Oosterom and Strackee's
+        // formula for its two triangles), times the density at its centre,
+        // is one: the camera picks one ray per pixel
+        let model = CameraModel::new(&camera(), 64, 48);
+        let corner = |x: f32, y: f32| Vec3::from(model.through_of(x, y)).as_dvec3();
+        let triangle = |a: glam::DVec3, b: glam::DVec3, c: glam::DVec3| {
+            let (la, lb, lc) = (a.length(), b.length(), c.length());
+            let denominator = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+            2.0 * a.dot(b.cross(c)).abs().atan2(denominator)
+        };
+        for (x, y) in [(32.0, 24.0), (0.0, 0.0), (63.0, 10.0)] {
+            let [a, b, c, d] = [corner(x, y), corner(x + 1.0, y), corner(x + 1.0, y + 1.0), corner(x, y + 1.0)];
+            let solid_angle = triangle(a, b, c) + triangle(a, c, d);
+            let centre = Vec3::from(model.through_of(x + 0.5, y + 0.5)).normalize();
+            let pixels = model.ray_pdf(centre) as f64 * solid_angle;
+            assert!((pixels - 1.0).abs() < 1e-3, "pixel ({x}, {y}): {pixels}");
+        }
+        assert_eq!(model.ray_pdf(-model.forward), 0.0);
     }
 
     #[test]

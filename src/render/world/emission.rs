@@ -66,6 +66,11 @@ pub struct Emission {
     pub pdf: f32,
     /// Cosine between the direction and the light's normal (1 where it has none).
     pub cos: f32,
+    /// The point it leaves from (an area light's, before the ray's offset;
+    /// a point or spot light's position) and the light's normal there (zero
+    /// where it has none).
+    pub point: Vec3,
+    pub normal: Vec3,
 }
 
 impl LightSource {
@@ -99,28 +104,33 @@ impl LightSource {
                 power: intensity * (4.0 * PI),
                 pdf: uniform_sphere_pdf(),
                 cos: 1.0,
+                point: position,
+                normal: Vec3::ZERO,
             },
             LightSource::Spot { position, direction, cos_cone, exponent, intensity, .. } => {
                 let one_minus_cos = 1.0 - cos_cone;
                 let d = Frame::from_z(direction).to_world(uniform_cone(u1, one_minus_cos));
                 let falloff = spot_factor(direction, d, cos_cone, exponent);
                 let pdf = uniform_cone_pdf(one_minus_cos);
-                Emission { ray: Ray::new(position, d), power: intensity * (falloff / pdf), pdf, cos: 1.0 }
+                let power = intensity * (falloff / pdf);
+                Emission { ray: Ray::new(position, d), power, pdf, cos: 1.0, point: position, normal: Vec3::ZERO }
             }
-            LightSource::Directional { direction, irradiance } => Emission {
-                ray: bounds.disc_origin(direction, u1),
-                power: irradiance * bounds.disc_area(),
-                pdf: 1.0 / bounds.disc_area(),
-                cos: 1.0,
-            },
+            LightSource::Directional { direction, irradiance } => {
+                let ray = bounds.disc_origin(direction, u1);
+                let (power, pdf) = (irradiance * bounds.disc_area(), 1.0 / bounds.disc_area());
+                Emission { ray, power, pdf, cos: 1.0, point: ray.origin, normal: Vec3::ZERO }
+            }
             LightSource::Background { radiance } => {
                 // Light from every direction: it travels along −ω for a sky direction ω
                 let direction = -uniform_sphere(u1);
+                let ray = bounds.disc_origin(direction, u2);
                 Emission {
-                    ray: bounds.disc_origin(direction, u2),
+                    ray,
                     power: radiance * (4.0 * PI * bounds.disc_area()),
                     pdf: uniform_sphere_pdf() / bounds.disc_area(),
                     cos: 1.0,
+                    point: ray.origin,
+                    normal: Vec3::ZERO,
                 }
             }
             LightSource::Area { radiance, ref emitter, .. } => {
@@ -135,6 +145,8 @@ impl LightSource {
                     power: radiance * (PI * area),
                     pdf: local.z / (PI * area),
                     cos: local.z,
+                    point,
+                    normal,
                 }
             }
         }

@@ -163,12 +163,17 @@ pub struct LightSample {
     pub on_triangle: Option<u32>,
     /// The sphere the sample lies on (facing the point): its shadow ray meets it only at its end.
     pub on_sphere: Option<u32>,
+    /// The sampled point and the light's normal there (an area light's;
+    /// a point or spot light's position and no normal; nothing for
+    /// infinite lights): what bidirectional methods weigh the sample by.
+    pub point: Vec3,
+    pub normal: Vec3,
 }
 
 impl LightSample {
     /// From a delta light: an infinite pdf, no surface under the sample.
     #[inline]
-    fn delta(shadow: Ray, shadow_t_max: f32, value: Rgb) -> Self {
+    fn delta(shadow: Ray, shadow_t_max: f32, value: Rgb, point: Vec3) -> Self {
         LightSample {
             wi: shadow.direction,
             value,
@@ -177,6 +182,8 @@ impl LightSample {
             shadow_t_max,
             on_triangle: None,
             on_sphere: None,
+            point,
+            normal: Vec3::ZERO,
         }
     }
 }
@@ -207,7 +214,7 @@ impl LightSource {
             LightSource::Point { position, intensity, attenuation } => {
                 let (shadow, shadow_t_max) = at.spawn_ray_to(position, 0.0);
                 let d = (position - p).length();
-                Some(LightSample::delta(shadow, shadow_t_max, intensity * attenuation.factor(d)))
+                Some(LightSample::delta(shadow, shadow_t_max, intensity * attenuation.factor(d), position))
             }
             LightSource::Spot { position, direction, cos_cone, exponent, intensity, attenuation } => {
                 let (shadow, shadow_t_max) = at.spawn_ray_to(position, 0.0);
@@ -216,10 +223,10 @@ impl LightSource {
                 if factor == 0.0 {
                     return None;
                 }
-                Some(LightSample::delta(shadow, shadow_t_max, intensity * (attenuation.factor(d) * factor)))
+                Some(LightSample::delta(shadow, shadow_t_max, intensity * (attenuation.factor(d) * factor), position))
             }
             LightSource::Directional { direction, irradiance } => {
-                Some(LightSample::delta(at.spawn_ray(-direction), f32::INFINITY, irradiance))
+                Some(LightSample::delta(at.spawn_ray(-direction), f32::INFINITY, irradiance, Vec3::ZERO))
             }
             LightSource::Background { radiance } => {
                 let pdf = uniform_sphere_pdf();
@@ -232,6 +239,8 @@ impl LightSource {
                     shadow_t_max: f32::INFINITY,
                     on_triangle: None,
                     on_sphere: None,
+                    point: Vec3::ZERO,
+                    normal: Vec3::ZERO,
                 })
             }
             LightSource::Area { radiance, ref emitter, .. } => {
@@ -253,6 +262,8 @@ impl LightSource {
                     shadow_t_max,
                     on_triangle,
                     on_sphere,
+                    point: target,
+                    normal,
                 })
             }
         }

@@ -64,6 +64,23 @@ pub struct World {
     pub(crate) light_plane: Vec<u32>,
 }
 
+/// The nine in ten of `points` nearest their median (per axis).
+fn nearest_nine_tenths(points: &[Vec3]) -> Vec<Vec3> {
+    let median = |axis: usize| {
+        let mut values: Vec<f32> = points.iter().map(|p| p[axis]).collect();
+        let middle = values.len() / 2;
+        match values.len() {
+            0 => 0.0,
+            _ => *values.select_nth_unstable_by(middle, f32::total_cmp).1,
+        }
+    };
+    let middle = Vec3::new(median(0), median(1), median(2));
+    let mut near = points.to_vec();
+    near.sort_by(|a, b| (*a - middle).length_squared().total_cmp(&(*b - middle).length_squared()));
+    near.truncate(points.len().div_ceil(10) * 9);
+    near
+}
+
 impl World {
     /// Compile a scene for rendering.
     pub fn new(scene: &ValidScene) -> Self {
@@ -358,15 +375,29 @@ impl World {
     /// outside the view, and fit the emitters' caps to what `camera` can see.
     /// The bounds of all finite objects would not do when walls are spheres
     /// of radius 1e5.
+    /// Where the farthest tenth of the visible points would more than
+    /// triple the region, they are left out: a ground plane seen to the
+    /// horizon puts a few of them hundreds of units off, and a region that
+    /// size would spread an infinite light's photons a thousand times too
+    /// thin over what is seen (the far ground then gets its light from the
+    /// other strategies alone).
     pub fn cover(&mut self, points: &[Vec3], camera: &CameraModel) {
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for p in points {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-        if lo.x <= hi.x {
-            self.bounds_center = (lo + hi) * 0.5;
-            self.bounds_radius = (hi - lo).length() * 0.75;
+        let bounds = |points: &[Vec3]| {
+            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            for p in points {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+            }
+            (lo.x <= hi.x).then(|| ((lo + hi) * 0.5, (hi - lo).length() * 0.75))
+        };
+        let near = bounds(&nearest_nine_tenths(points));
+        let region = match (bounds(points), near) {
+            (Some(all), Some(near)) if all.1 > 3.0 * near.1 => Some(near),
+            (all, _) => all,
+        };
+        if let Some((center, radius)) = region {
+            self.bounds_center = center;
+            self.bounds_radius = radius;
         }
         let eye = camera.central_origin();
         self.fit_caps(Some(eye));

@@ -16,8 +16,8 @@ use super::light::{Emitter, LightSample, LightSource};
 use super::shapes::{PlaneShape, Spheres};
 use super::spheres::SphereLanes;
 use crate::geometry::sphere::AnchoredSphere;
-use crate::geometry::Triangle;
 use crate::geometry::{gamma, intersect_triangle, plane_t};
+use crate::geometry::{Ray, Triangle};
 
 /// A region a wall bounds, in f64 for exact inside tests.
 #[derive(Clone, Copy, Debug)]
@@ -272,6 +272,15 @@ impl<'w> Occluders<'w> {
     ) -> Self {
         let (spheres, planes) = if held { (&walls.spheres, &walls.planes[..]) } else { (spheres, planes) };
         Occluders { spheres, planes, triangles, light_plane }
+    }
+
+    /// Whether anything lies on `ray` before `t_max` (a connection of two
+    /// path vertices, or of one to the camera).
+    #[inline]
+    pub fn segment_blocked(&self, ray: &Ray, t_max: f32) -> bool {
+        self.spheres.any_hit_except(ray, t_max, None)
+            || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
+            || self.triangles.iter().any(|(triangle, _)| intersect_triangle(ray, triangle, t_max).is_some())
     }
 
     /// Whether anything lies between the shading point and the light sample.

@@ -44,6 +44,16 @@ impl LightPicker {
         self.total.is_nan() || self.total <= 0.0
     }
 
+    /// The probability of picking light `index`.
+    #[inline]
+    pub fn probability(&self, index: usize) -> f32 {
+        if self.is_empty() || index >= self.cdf.len() {
+            return 0.0;
+        }
+        let previous = if index == 0 { 0.0 } else { self.cdf[index - 1] };
+        (self.cdf[index] - previous) / self.total
+    }
+
     /// (light index, probability of picking it).
     #[inline]
     pub fn pick(&self, u: f32) -> Option<(usize, f32)> {

@@ -1,0 +1,233 @@
+//! Light tracing, bidirectional path tracing, bidirectional photon mapping
+//! and vertex connection and merging: one engine (after SmallVCM, Georgiev
+//! et al. 2012), four sets of strategies. Each pass traces one light
+//! subpath per pixel, keeps its non-specular vertices (and, to merge, a
+//! kd-tree of them, the photon map's own), joins them to the camera, then
+//! traces one camera subpath per pixel that samples lights, connects to its
+//! pixel's light subpath and merges with the light vertices around it.
+//!
+//! - Light tracing: only the light subpaths' joins to the camera (and what
+//!   the camera sees of the lights straight on).
+//! - BDPT: every connection, weighed by multiple importance sampling.
+//! - Bidirectional photon mapping: only merges, weighed among themselves.
+//! - VCM: both, the merge radius shrinking as pass^−(1−α)/2, so the image
+//!   converges where a caustic seen in a mirror leaves BDPT nothing.
+
+pub mod camera_paths;
+pub mod light_paths;
+pub mod mis;
+
+use rayon::prelude::*;
+
+use super::photon_map::emit::LightPicker;
+use super::photon_map::kdtree::KdTree;
+use super::{Counters, PassObserver, PassReport, Stage};
+use crate::geometry::Ray;
+use crate::render::film::{Film, TermSums};
+use crate::render::settings::{Algorithm, Method, MisHeuristic, RenderSettings};
+use crate::render::world::camera::{CameraModel, CameraTile};
+use crate::render::world::emission::Bounds;
+use crate::render::world::light::LightSource;
+use crate::render::world::World;
+use camera_paths::{LightSide, MergePoint};
+use mis::Strategies;
+
+/// Bidirectional work of one pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PathPassStats {
+    pub light_paths: u64,
+    pub light_vertices: u64,
+    /// Connections traced (to the camera, to lights, between vertices).
+    pub connections: u64,
+    /// Light vertices merged into camera vertices.
+    pub merges: u64,
+    /// The merge radius of the pass (0 without merging).
+    pub merge_radius: f32,
+}
+
+/// Which strategies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mode {
+    LightTracing,
+    Connect,
+    Merge,
+    ConnectAndMerge,
+}
+
+/// One bidirectional method over a film.
+pub struct Bidir {
+    mode: Mode,
+    heuristic: MisHeuristic,
+    /// The merge radius of the first pass, and its reduction α.
+    radius: f32,
+    alpha: f32,
+    max_length: u32,
+    seed: u64,
+    picker: LightPicker,
+}
+
+/// What the subpaths of a pass share.
+pub struct Context<'a> {
+    pub world: &'a World,
+    pub camera: &'a CameraModel,
+    pub strategies: Strategies,
+    pub picker: &'a LightPicker,
+    pub bounds: Bounds,
+    /// The background light, if the scene has one.
+    pub background: Option<usize>,
+    /// Longest path, in segments.
+    pub max_length: u32,
+    /// Plain light tracing: joins to the camera weigh 1, camera paths only
+    /// see lights straight on.
+    pub light_tracing: bool,
+}
+
+impl Context<'_> {
+    /// Whether light vertices are kept (to connect or merge).
+    pub fn keeps_vertices(&self) -> bool {
+        self.strategies.connect || self.strategies.merge
+    }
+
+    /// Whether anything blocks `ray` before `t_max`; `held`: both ends
+    /// inside every wall, which it then cannot cross.
+    #[inline]
+    pub fn blocked(&self, held: bool, ray: &Ray, t_max: f32) -> bool {
+        self.world.occluders(held).segment_blocked(ray, t_max)
+    }
+}
+
+impl Bidir {
+    /// For `settings`' method (one of the four) on `world`; the merge
+    /// radius, when the settings leave it, is 1% of what the camera sees.
+    pub fn new(world: &World, settings: &RenderSettings, visible_radius: f32) -> Self {
+        let (mode, heuristic, radius, alpha) = match &settings.method {
+            Method::Bdpt(b) => (Mode::Connect, b.mis, 0.0, 1.0),
+            Method::Bpm(m) => (Mode::Merge, m.mis, m.radius, m.alpha),
+            Method::Vcm(m) => (Mode::ConnectAndMerge, m.mis, m.radius, m.alpha),
+            _ => (Mode::LightTracing, MisHeuristic::Power, 0.0, 1.0),
+        };
+        let radius = if radius > 0.0 { radius } else { (visible_radius * 0.01).max(1e-6) };
+        Self {
+            mode,
+            heuristic,
+            radius,
+            alpha,
+            max_length: settings.max_depth.max(1),
+            seed: settings.seed,
+            picker: LightPicker::new(world),
+        }
+    }
+
+    /// The algorithm it is.
+    pub fn algorithm(&self) -> Algorithm {
+        match self.mode {
+            Mode::LightTracing => Algorithm::LightTracing,
+            Mode::Connect => Algorithm::Bdpt,
+            Mode::Merge => Algorithm::Bpm,
+            Mode::ConnectAndMerge => Algorithm::Vcm,
+        }
+    }
+
+    /// The merge radius of pass `pass` (from 0): r₀ / (pass + 1)^((1−α)/2).
+    pub fn merge_radius(&self, pass: u32) -> f32 {
+        (self.radius / ((pass + 1) as f32).powf(0.5 * (1.0 - self.alpha))).max(1e-7)
+    }
+
+    /// The strategies of pass `pass` over `pixels` pixels.
+    fn strategies(&self, pass: u32, pixels: f32) -> Strategies {
+        let connect = matches!(self.mode, Mode::Connect | Mode::ConnectAndMerge);
+        let merge = matches!(self.mode, Mode::Merge | Mode::ConnectAndMerge);
+        Strategies::new(self.heuristic, connect, merge, pixels, self.merge_radius(pass))
+    }
+
+    /// One pass: the light subpaths, then the camera subpaths tile by tile,
+    /// then the light subpaths' joins to the camera. None if abandoned.
+    pub fn pass(&self, stage: &Stage, film: &mut Film, pass: u32, observer: &dyn PassObserver) -> Option<PassReport> {
+        let world = stage.world;
+        let pixels = film.width as u64 * film.height as u64;
+        let strategies = self.strategies(pass, pixels as f32);
+        let background = world.lights.iter().position(|l| matches!(l, LightSource::Background { .. }));
+        let ctx = Context {
+            world,
+            camera: stage.camera,
+            strategies,
+            picker: &self.picker,
+            bounds: world.bounds(),
+            background,
+            max_length: self.max_length,
+            light_tracing: self.mode == Mode::LightTracing,
+        };
+        let keep_going = || observer.is_current();
+        let paths = light_paths::trace(&ctx, pixels, pass as u64, self.seed, &keep_going)?;
+        let tree = strategies.merge.then(|| KdTree::build(MergePoint::of(&paths.vertices)));
+        if !observer.is_current() {
+            return None;
+        }
+        let light = LightSide { paths: &paths, tree: tree.as_ref(), radius: self.merge_radius(pass) };
+        let streams = stage.streams(pass as u64);
+        let width = film.width;
+        let per_tile: Vec<Counters> = film
+            .tiles
+            .par_iter_mut()
+            .with_max_len(1)
+            .map(|tile| {
+                let mut counters = Counters::default();
+                if !observer.is_current() {
+                    return counters;
+                }
+                let camera_tile = CameraTile { camera: stage.camera, rect: tile.rect, streams };
+                for i in 0..tile.rect.pixels() {
+                    let (x, y) = tile.rect.pixel(i);
+                    let (ray, mut sampler) = camera_tile.sample(i);
+                    let pixel = (y * width + x) as usize;
+                    let value = camera_paths::radiance(&ctx, &light, pixel, ray, &mut sampler, &mut counters);
+                    let value = stage.accept(value, &mut counters).unwrap_or_default();
+                    tile.add(i, value);
+                }
+                counters
+            })
+            .collect();
+        if !observer.is_current() {
+            return None;
+        }
+        let mut report = PassReport::default();
+        report.counters.add(&paths.counters);
+        for counters in &per_tile {
+            report.counters.add(counters);
+        }
+        // The joins to the camera, each accepted as a sample is
+        let mut rejected = Counters::default();
+        let splats: Vec<Vec<_>> = (paths.splats.iter())
+            .map(|chunk| {
+                (chunk.iter())
+                    .filter_map(|splat| {
+                        let value = stage.accept(splat.value, &mut rejected)?;
+                        Some(crate::render::film::Splat { value, ..*splat })
+                    })
+                    .collect()
+            })
+            .collect();
+        report.counters.non_finite += rejected.non_finite;
+        film.add_splats(splats);
+        let mut noise = TermSums::default();
+        for tile in &mut film.tiles {
+            tile.samples += 1;
+            if observer.wants_tiles() {
+                let variance = if observer.wants_variance() { tile.variance() } else { None };
+                observer.tile(tile.rect, tile.mean(), variance);
+            }
+            if observer.wants_noise(pass) {
+                noise.add(&tile.noise_terms());
+            }
+        }
+        report.noise = noise;
+        report.paths = PathPassStats {
+            light_paths: pixels,
+            light_vertices: report.counters.light_vertices,
+            connections: report.counters.connections,
+            merges: report.counters.merges,
+            merge_radius: if strategies.merge { self.merge_radius(pass) } else { 0.0 },
+        };
+        Some(report)
+    }
+}
