@@ -31,7 +31,7 @@ pub struct ReferenceArgs {
     /// (default: the reference cache).
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
-    /// Use this method, not the one the scene needs (path or sppm).
+    /// Use this method, not the one the scene needs (path, bdpt, sppm or vcm).
     #[arg(long = "method")]
     pub method: Option<Algorithm>,
     #[command(flatten)]
@@ -72,8 +72,9 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     if args.flags.algorithm != Algorithm::Path {
         bail!("references choose their method (see --method); --algo does not apply");
     }
-    if let Some(method) = args.method.filter(|m| !matches!(m, Algorithm::Path | Algorithm::Sppm)) {
-        bail!("--method {method}: references are path traced or made by progressive photon mapping (path, sppm)");
+    let converges = |m: &Algorithm| matches!(m, Algorithm::Path | Algorithm::Bdpt | Algorithm::Sppm | Algorithm::Vcm);
+    if let Some(method) = args.method.filter(|m| !converges(m)) {
+        bail!("--method {method}: references are made by a method that converges everywhere (path, bdpt, sppm, vcm)");
     }
     enum Target {
         Files(Vec<PathBuf>),

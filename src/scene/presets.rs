@@ -12,6 +12,9 @@ pub const PRESETS: &[(&str, &str)] = &[
     ("thesis", include_str!("../../assets/scenes/thesis.ron")),
     ("lights", include_str!("../../assets/scenes/lights.ron")),
     ("caustics", include_str!("../../assets/scenes/caustics.ron")),
+    ("mirror-caustic", include_str!("../../assets/scenes/mirror-caustic.ron")),
+    ("gap-room", include_str!("../../assets/scenes/gap-room.ron")),
+    ("glossy", include_str!("../../assets/scenes/glossy.ron")),
 ];
 
 pub fn names() -> impl Iterator<Item = &'static str> {

@@ -32,6 +32,21 @@ const EMBEDDED: &[(&str, &[u8], &str)] = &[
         include_bytes!("../../../assets/references/caustics.exr"),
         include_str!("../../../assets/references/caustics.exr.meta.ron"),
     ),
+    (
+        "mirror-caustic",
+        include_bytes!("../../../assets/references/mirror-caustic.exr"),
+        include_str!("../../../assets/references/mirror-caustic.exr.meta.ron"),
+    ),
+    (
+        "gap-room",
+        include_bytes!("../../../assets/references/gap-room.exr"),
+        include_str!("../../../assets/references/gap-room.exr.meta.ron"),
+    ),
+    (
+        "glossy",
+        include_bytes!("../../../assets/references/glossy.exr"),
+        include_str!("../../../assets/references/glossy.exr.meta.ron"),
+    ),
 ];
 
 /// The compiled-in reference of `scene`, if it is a preset as shipped.

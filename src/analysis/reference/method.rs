@@ -19,30 +19,24 @@ pub struct ReferenceMethod {
     pub reason: &'static str,
 }
 
-/// Path tracing where its estimate converges; SPPM (consistent) where
-/// light can reach the camera only through mirrors or glass from a point,
-/// spot or directional light — a caustic path tracing never finds, since
-/// no direction it samples can hit a delta light — unless the background
-/// lights the scene: photons do not yet leave it, so SPPM misses all the
-/// sky light that arrives after a bounce (on the thesis' scene, whose sky
-/// is dim, its reference read up to 1.8× too dark on the objects' shaded
-/// sides), a larger error than the caustic path tracing misses.
+/// Path tracing where its estimate converges; vertex connection and
+/// merging (consistent) where light can reach the camera through mirrors or
+/// glass from a point, spot or directional light: a caustic path tracing
+/// never finds, since no direction it samples can hit a delta light, and
+/// BDPT not where the caustic is itself seen in a mirror (light, glass,
+/// floor, mirror, camera). VCM merges those and connects the rest. (SPPM
+/// did this before VCM; it carried the background's light only once the
+/// background became a light.)
 pub fn reference_method(scene: &Scene) -> ReferenceMethod {
     let delta_light = scene.lights.iter().any(|l| l.enabled && l.intensity > 0.0 && l.color.max_element() > 0.0);
     let specular = scene.objects.iter().any(|o| {
         let model = scene.material_index(&o.material).map(|m| &scene.materials[m].model);
         matches!(model, Some(MaterialModel::Mirror { .. } | MaterialModel::Glass { .. }))
     });
-    let lit_background = scene.background.max_element() > 0.0;
-    if delta_light && specular && lit_background {
+    if delta_light && specular {
         ReferenceMethod {
-            algorithm: Algorithm::Path,
-            reason: "path tracing: the background lights the scene, which photons do not yet carry (a point-like light's caustic through mirrors or glass is missing)",
-        }
-    } else if delta_light && specular {
-        ReferenceMethod {
-            algorithm: Algorithm::Sppm,
-            reason: "progressive photon mapping: a point-like light shines through mirrors or glass, a caustic path tracing cannot find",
+            algorithm: Algorithm::Vcm,
+            reason: "vertex connection and merging: a point-like light shines through mirrors or glass, a caustic path tracing cannot find",
         }
     } else {
         ReferenceMethod { algorithm: Algorithm::Path, reason: "path tracing: it converges on this scene" }
@@ -74,17 +68,15 @@ mod tests {
     use crate::scene::presets;
 
     #[test]
-    fn a_point_light_through_glass_asks_for_photons_and_nothing_else_does() {
+    fn a_point_light_through_glass_asks_for_merging_and_nothing_else_does() {
         let method = |name: &str| reference_method(&presets::preset(name).unwrap().unwrap().into_scene()).algorithm;
-        // Area lights only, or point lights without mirrors or glass; the
-        // thesis' chrome ball throws the key light's caustic, but its sky
-        // lights the scene, which photons do not carry
-        for name in ["cornell", "smallpt", "caustics", "lights", "thesis"] {
+        // Area lights only, or point lights without mirrors or glass
+        for name in ["cornell", "smallpt", "caustics", "lights", "gap-room", "glossy"] {
             assert_eq!(method(name), Algorithm::Path, "{name}");
         }
-        let mut night = presets::preset("thesis").unwrap().unwrap().into_scene();
-        night.background = glam::Vec3::ZERO;
-        assert_eq!(reference_method(&night).algorithm, Algorithm::Sppm);
+        // The thesis' chrome ball throws the key light's caustic, under a sky or not
+        assert_eq!(method("thesis"), Algorithm::Vcm);
+        assert_eq!(method("mirror-caustic"), Algorithm::Vcm);
         let mut scene = presets::preset("cornell").unwrap().unwrap().into_scene();
         let point = crate::scene::LightKind::Point { position: glam::Vec3::new(0.0, 1.5, 0.0) };
         scene.lights.push(crate::scene::Light {
@@ -95,7 +87,7 @@ mod tests {
             attenuation: Default::default(),
             enabled: true,
         });
-        assert_eq!(reference_method(&scene).algorithm, Algorithm::Sppm);
+        assert_eq!(reference_method(&scene).algorithm, Algorithm::Vcm);
         scene.lights[0].enabled = false;
         assert_eq!(reference_method(&scene).algorithm, Algorithm::Path);
     }
