@@ -29,7 +29,7 @@ fn render(preset: &str, spp: u32, seed: u64) -> (LinearImage, LinearImage, PassS
     let generation =
         session.start(RenderJob { stream_tiles: false, estimate_noise: true, ..RenderJob::new(scene, settings) });
     for event in session.events().iter() {
-        if let RenderEvent::Finished { generation: g, image, variance, stats } = event {
+        if let RenderEvent::Finished { generation: g, image, variance, stats, .. } = event {
             if g == generation {
                 return ((*image).clone(), (*variance.expect("path tracing keeps halves")).clone(), stats);
             }

@@ -417,3 +417,28 @@ fn an_edited_scene_is_measured_against_a_reference_made_in_the_background() {
     step_long_until(&mut harness, |app| app.references().source() == Some(&Source::Cache));
     assert_eq!(kept(cache.path()), 1, "nothing rendered again");
 }
+
+/// A BDPT pane's "Strategies" button opens the strategy view, which fills
+/// with every strategy's image as passes arrive, each told with its share
+/// of the pane's light; closing it renders without them again.
+#[test]
+fn the_strategy_view_shows_each_strategy_with_its_share() {
+    let mut harness = studio(1);
+    let pane = &mut harness.state_mut().panes_mut().list_mut()[0];
+    pane.settings_mut().method = gi_studio::render::Method::of(gi_studio::render::Algorithm::Bdpt);
+    pane.settings_mut().samples_per_pixel = Some(8);
+    harness.state_mut().restart_all();
+    harness.run_steps(2);
+    harness.get_by_label("Strategies").click();
+    harness.run_steps(1);
+    step_until(&mut harness, |app| app.panes().list()[0].state().strategies.as_ref().is_some_and(|s| s.passes >= 2));
+    harness.run_steps(2);
+    let cell = harness.get_by_label_contains("(s, t) = (1, 2): ");
+    let label = egui_kittest::kittest::NodeT::accesskit_node(&cell).label().unwrap_or_default();
+    assert!(label.ends_with("% of the pane's light"), "{label}");
+    let share: f64 = label.split(": ").nth(1).and_then(|t| t.split('%').next()).and_then(|p| p.parse().ok()).unwrap();
+    assert!(share > 0.0 && share < 100.0, "{label}");
+    harness.get_by_label("Strategies").click();
+    harness.run_steps(2);
+    assert!(harness.query_by_label_contains("(s, t) = (1, 2): ").is_none(), "the view closed");
+}

@@ -21,6 +21,7 @@ mod plots;
 mod references;
 mod status;
 mod storage;
+mod strategies;
 mod studio;
 mod viewport;
 

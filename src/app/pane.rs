@@ -8,11 +8,13 @@ use std::time::Duration;
 
 use eframe::egui;
 
+use super::strategies::{strategies_ui, StrategyView};
 use crate::analysis::metrics::{rel_mse_against, ErrorEstimate};
 use crate::analysis::reference::{Reference, REFERENCE_PASSES};
 use crate::limits;
 use crate::render::film::NoiseEstimate;
 use crate::render::image::Tonemap;
+use crate::render::integrators::bidir::strategies::StrategyImages;
 use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::world::camera::TileRect;
 use crate::render::{
@@ -78,6 +80,8 @@ pub struct PaneState {
     pub maps: Option<PhotonMapStats>,
     pub failed: Option<String>,
     pub finished: bool,
+    /// What each strategy brought, for a bidirectional pane whose view is open.
+    pub strategies: Option<Arc<StrategyImages>>,
     /// When (seconds into the job) the error was last measured.
     measured_at: f64,
 }
@@ -93,6 +97,7 @@ impl PaneState {
             maps: None,
             failed: None,
             finished: false,
+            strategies: None,
             measured_at: 0.0,
         }
     }
@@ -158,6 +163,7 @@ impl PaneState {
                 self.stats = Some(stats);
                 self.finished = true;
             }
+            RenderEvent::Strategies { images, .. } => self.strategies = Some(images),
             RenderEvent::Failed { message, .. } => self.failed = Some(message),
         }
         true
@@ -199,6 +205,7 @@ pub struct Pane {
     /// None when the OS refused its thread (said in `state.failed`).
     session: Option<RenderSession>,
     texture: Option<egui::TextureHandle>,
+    strategy_view: StrategyView,
 }
 
 impl Pane {
@@ -219,7 +226,7 @@ impl Pane {
                 None
             }
         };
-        Self { state, settings, exposure, session, texture: None }
+        Self { state, settings, exposure, session, texture: None, strategy_view: StrategyView::default() }
     }
 
     pub fn settings(&self) -> &RenderSettings {
@@ -243,10 +250,28 @@ impl Pane {
         self.settings.algorithm()
     }
 
+    /// Whether its algorithm has strategies to show (the bidirectional ones).
+    pub fn has_strategies(&self) -> bool {
+        matches!(self.algorithm(), Algorithm::LightTracing | Algorithm::Bdpt | Algorithm::Bpm | Algorithm::Vcm)
+    }
+
+    pub fn strategy_view_mut(&mut self) -> &mut StrategyView {
+        &mut self.strategy_view
+    }
+
+    /// The strategy window, while it is open.
+    pub fn strategies_ui(&mut self, ctx: &egui::Context, index: usize) {
+        let light = self.state.image.mean();
+        let pane_light = (light[0] + light[1] + light[2]) / 3.0;
+        let images = self.state.strategies.clone();
+        strategies_ui(ctx, index, &mut self.strategy_view, images, self.exposure, pane_light);
+    }
+
     /// Abandon the current job and render `scene` afresh (never waits).
     pub fn restart(&mut self, scene: Arc<ValidScene>) {
         let Some(session) = &self.session else { return };
-        let job = RenderJob { estimate_noise: true, ..RenderJob::new(scene, self.settings.clone()) };
+        let strategies = self.strategy_view.open && self.has_strategies();
+        let job = RenderJob { estimate_noise: true, strategies, ..RenderJob::new(scene, self.settings.clone()) };
         let generation = session.start(job);
         self.state = PaneState::new(generation, self.settings.width, self.settings.height);
     }
@@ -507,7 +532,8 @@ mod tests {
         assert!(measured[8..].iter().all(|p| p % 3 == 0), "only the newest pass of a poll");
         assert!(state.latest_error().is_some());
         let image = Arc::new(LinearImage::new(4, 4));
-        state.apply(RenderEvent::Finished { generation: 1, stats: stats(1000), image, variance: None }, None, true);
+        let event = RenderEvent::Finished { generation: 1, stats: stats(1000), image, variance: None, odd: None };
+        state.apply(event, None, true);
         assert!(state.history.last().unwrap().error.is_some(), "the final image is measured");
     }
 }

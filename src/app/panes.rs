@@ -181,7 +181,18 @@ impl Panes {
             restart |= ui.small_button("Restart").on_hover_text("Restart this pane").clicked();
             let hint = "Measure every pane against this pane's image from now on";
             promote |= ui.small_button("Use as reference").on_hover_text(hint).clicked();
+            if pane.has_strategies() {
+                let view = pane.strategy_view_mut();
+                let hint = "What each way of joining light and camera paths brings to this pane";
+                if ui.selectable_label(view.open, "Strategies").on_hover_text(hint).clicked() {
+                    view.open = !view.open;
+                    restart = true;
+                }
+            }
         });
+        if pane.strategy_view_mut().open && pane.has_strategies() {
+            pane.strategies_ui(ui.ctx(), index);
+        }
         if restart {
             if let Some(scene) = document.valid() {
                 pane.restart(scene.clone());

@@ -55,7 +55,7 @@ pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
                 plot.hline(HLine::new("reference's own noise", floor.log10()).style(LineStyle::dotted_dense()));
             }
         });
-        photon_ui(&mut columns[3], panes, height);
+        photons_and_paths_ui(&mut columns[3], panes, height);
     });
 }
 
@@ -63,8 +63,8 @@ fn series_name(index: usize, pane: &Pane) -> String {
     format!("{} {}", index + 1, pane.algorithm().name())
 }
 
-fn photon_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
-    ui.label("Photon maps");
+fn photons_and_paths_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
+    ui.label("Photon maps and light paths");
     let mut any = false;
     for (i, pane) in panes.iter().enumerate() {
         if let Some(maps) = &pane.state().maps {
@@ -134,7 +134,24 @@ fn photon_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
             }
         });
     }
+    for (i, pane) in panes.iter().enumerate() {
+        let Some(stats) = &pane.state().stats else { continue };
+        let p = &stats.paths;
+        if p.light_paths > 0 {
+            any = true;
+            let per = |n: u64| n as f64 / p.light_paths as f64;
+            let radius =
+                if p.merge_radius > 0.0 { format!(" · merge radius {:.4}", p.merge_radius) } else { String::new() };
+            ui.small(format!(
+                "{}: {:.2} light vertices a path · per pixel {:.2} connections, {:.2} merges{radius}",
+                i + 1,
+                per(p.light_vertices),
+                per(p.connections),
+                per(p.merges)
+            ));
+        }
+    }
     if !any {
-        ui.weak("Statistics appear when a pane renders with photon mapping or SPPM.");
+        ui.weak("Statistics appear when a pane renders with photon mapping, SPPM or a bidirectional method.");
     }
 }

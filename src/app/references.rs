@@ -359,7 +359,7 @@ impl References {
                     failure = Some(format!("the reference could not be rendered: {message}"));
                     current.source = Source::Unavailable(message);
                 }
-                RenderEvent::Started { .. } | RenderEvent::PhotonMaps { .. } => {}
+                RenderEvent::Started { .. } | RenderEvent::PhotonMaps { .. } | RenderEvent::Strategies { .. } => {}
             }
         }
         if finished {

@@ -222,6 +222,18 @@ impl Film {
         }
     }
 
+    /// The odd passes' mean (the second, fourth… pass counted from 1),
+    /// where the film keeps halves and has two passes.
+    pub fn odd_image(&self) -> Option<LinearImage> {
+        let odd_mean = |tile: &FilmTile| -> Option<Vec<[f32; 3]>> {
+            let odd = tile.samples / 2;
+            (!tile.odd_sums.is_empty() && odd >= 1)
+                .then(|| tile.odd_sums.iter().map(|s| s.map(|c| (c / odd as f64) as f32)).collect())
+        };
+        let per_tile: Vec<Vec<[f32; 3]>> = self.tiles.iter().map(odd_mean).collect::<Option<_>>()?;
+        Some(self.image(|i| per_tile[i].clone()))
+    }
+
     /// Every pixel's estimated variance (`FilmTile::variance`), where the
     /// film keeps halves and has two passes.
     pub fn variance(&self) -> Option<LinearImage> {

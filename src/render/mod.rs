@@ -13,6 +13,7 @@ pub mod engine;
 pub mod film;
 pub mod image;
 pub mod integrators;
+pub mod layers;
 pub mod settings;
 pub mod world;
 

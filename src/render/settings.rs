@@ -58,6 +58,14 @@ impl Algorithm {
         }
     }
 
+    /// Whether its passes are independent samples of the same estimate, so
+    /// a render splits into ranges of passes (shards) that merge exactly;
+    /// otherwise each pass builds on the ones before (a shrinking radius)
+    /// and shards are independent runs, merged by weighting.
+    pub fn has_independent_passes(self) -> bool {
+        !matches!(self, Algorithm::Sppm | Algorithm::Bpm | Algorithm::Vcm)
+    }
+
     /// Whether its passes are independent unbiased estimates of the
     /// converged image: then the spread between them is its error, and the
     /// film keeps its odd passes apart to measure it.
@@ -174,7 +182,7 @@ pub struct BidirSettings {
 }
 
 /// Vertex merging (bidirectional photon mapping, and VCM's merges): the
-/// merge radius at the first pass (0: 1% of what the camera sees), which
+/// merge radius at the first pass (0: 2% of what the camera sees), which
 /// shrinks as pass^−(1−α)/2.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -241,6 +249,9 @@ pub struct RenderSettings {
     pub height: u32,
     /// Stop after this many samples per pixel (one per pass); None: no limit.
     pub samples_per_pixel: Option<u32>,
+    /// The index of the first pass: a shard of a render starts where the
+    /// ones before it end (`cli::shard`), so its samples are theirs.
+    pub first_pass: u32,
     /// Stop once this many seconds have passed (checked between passes).
     pub time_limit: Option<f64>,
     pub seed: u64,
@@ -260,6 +271,7 @@ impl Default for RenderSettings {
             width: 640,
             height: 480,
             samples_per_pixel: None,
+            first_pass: 0,
             time_limit: None,
             seed: 0,
             max_depth: Algorithm::Path.default_max_depth(),
@@ -334,6 +346,7 @@ impl RenderSettings {
         };
         check("size", limits::check_image_size(self.width, self.height));
         check("samples_per_pixel", self.samples_per_pixel.map_or(Ok(()), |n| ok(limits::SAMPLES_PER_PIXEL.check(n))));
+        check("first_pass", ok(limits::SAMPLES_PER_PIXEL.check(self.first_pass.max(1))));
         check("time_limit", self.time_limit.map_or(Ok(()), |t| ok(limits::SECONDS.check(t))));
         check("max_depth", ok(limits::MAX_DEPTH.check(self.max_depth)));
         check("firefly_clamp", ok(limits::LENGTH.check(self.firefly_clamp)));

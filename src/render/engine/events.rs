@@ -5,6 +5,7 @@ use std::time::Duration;
 
 use crate::render::film::NoiseEstimate;
 use crate::render::image::LinearImage;
+use crate::render::integrators::bidir::strategies::StrategyImages;
 use crate::render::integrators::bidir::PathPassStats;
 use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::integrators::PhotonPassStats;
@@ -47,12 +48,20 @@ pub enum RenderEvent {
         generation: u64,
         stats: PassStats,
     },
+    /// What each strategy of a bidirectional method has brought so far.
+    Strategies {
+        generation: u64,
+        images: Arc<StrategyImages>,
+    },
     Finished {
         generation: u64,
         image: Arc<LinearImage>,
         /// Each pixel's estimated variance of its mean, for unbiased
         /// methods (`Algorithm::is_unbiased`) after two passes.
         variance: Option<Arc<LinearImage>>,
+        /// The odd passes' mean alone, where there is a variance: what a
+        /// shard carries so that merged shards have one.
+        odd: Option<Arc<LinearImage>>,
         stats: PassStats,
     },
     Failed {
@@ -66,6 +75,7 @@ impl RenderEvent {
         match self {
             RenderEvent::Started { generation, .. }
             | RenderEvent::PassFinished { generation, .. }
+            | RenderEvent::Strategies { generation, .. }
             | RenderEvent::PhotonMaps { generation, .. }
             | RenderEvent::Finished { generation, .. }
             | RenderEvent::Failed { generation, .. } => *generation,
@@ -78,7 +88,7 @@ impl RenderEvent {
     pub fn is_news(&self) -> bool {
         match self {
             RenderEvent::Tile(tile) => tile.preview,
-            RenderEvent::PassFinished { .. } => false,
+            RenderEvent::PassFinished { .. } | RenderEvent::Strategies { .. } => false,
             _ => true,
         }
     }

@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use super::events::{Notify, PassStats, RenderEvent, TileUpdate};
 use super::workers::Workers;
 use crate::render::film::Film;
+use crate::render::integrators::bidir::strategies::StrategyImages;
 use crate::render::integrators::photon_map::PhotonMaps;
 use crate::render::integrators::{Integrator, PassObserver, Stage};
 use crate::render::settings::RenderSettings;
@@ -37,11 +38,22 @@ pub struct RenderJob {
     /// Estimate the render's own relMSE (`PassStats::noise`, unbiased
     /// methods only) now and then: what a viewer without a reference shows.
     pub estimate_noise: bool,
+    /// Send what each strategy of a bidirectional method brings, now and
+    /// then (the studio's strategy view).
+    pub strategies: bool,
 }
 
 impl RenderJob {
     pub fn new(scene: Arc<ValidScene>, settings: RenderSettings) -> Self {
-        Self { scene, settings, photon_maps: None, stream_tiles: true, stream_variance: false, estimate_noise: false }
+        Self {
+            scene,
+            settings,
+            photon_maps: None,
+            stream_tiles: true,
+            stream_variance: false,
+            estimate_noise: false,
+            strategies: false,
+        }
     }
 }
 
@@ -52,6 +64,7 @@ pub(super) struct JobContext<'a> {
     pub stream_tiles: bool,
     pub stream_variance: bool,
     pub estimate_noise: bool,
+    pub strategies: bool,
     pub current: &'a AtomicU64,
     pub events: &'a Sender<RenderEvent>,
     pub notify: Option<&'a Notify>,
@@ -91,6 +104,14 @@ impl PassObserver for JobContext<'_> {
     fn tile(&self, rect: TileRect, pixels: Vec<[f32; 3]>, variance: Option<Vec<[f32; 3]>>) {
         let generation = self.generation;
         self.send(RenderEvent::Tile(TileUpdate { generation, rect, pixels, preview: false, variance }));
+    }
+
+    fn wants_strategies(&self) -> bool {
+        self.strategies
+    }
+
+    fn strategies(&self, images: StrategyImages) {
+        self.send(RenderEvent::Strategies { generation: self.generation, images: Arc::new(images) });
     }
 }
 
@@ -142,7 +163,8 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
             break;
         }
         let pass_start = Instant::now();
-        let Some(report) = workers.run(|| integrator.pass(&stage, &mut film, stats.passes, context)) else {
+        let pass = settings.first_pass + stats.passes;
+        let Some(report) = workers.run(|| integrator.pass(&stage, &mut film, pass, context)) else {
             return;
         };
         stats.rays += report.counters.rays;
@@ -158,5 +180,6 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
     }
     let image = film.image(|tile| integrator.tile_pixels(&film, tile));
     let variance = film.variance().map(Arc::new);
-    context.send(RenderEvent::Finished { generation, image: Arc::new(image), variance, stats });
+    let odd = film.odd_image().map(Arc::new);
+    context.send(RenderEvent::Finished { generation, image: Arc::new(image), variance, odd, stats });
 }

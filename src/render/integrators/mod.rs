@@ -115,6 +115,12 @@ pub trait PassObserver: Sync {
     /// (counted from 0).
     fn wants_noise(&self, pass: u32) -> bool;
     fn tile(&self, rect: TileRect, pixels: Vec<[f32; 3]>, variance: Option<Vec<[f32; 3]>>);
+    /// Whether it shows what each strategy of a bidirectional method brings.
+    fn wants_strategies(&self) -> bool {
+        false
+    }
+    /// Every strategy's images so far (when it wants them).
+    fn strategies(&self, _images: bidir::strategies::StrategyImages) {}
 }
 
 /// Sample index used for the coarse preview, outside any real pass's range.

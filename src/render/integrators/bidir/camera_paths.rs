@@ -9,6 +9,7 @@ use glam::Vec3;
 
 use super::light_paths::{LightPaths, LightVertex};
 use super::mis::{self, Partials};
+use super::strategies::{Strategy, Tally};
 use super::Context;
 use crate::geometry::Ray;
 use crate::render::integrators::next_event::PathScope;
@@ -72,14 +73,16 @@ struct CameraVertex<'a> {
     length: u32,
 }
 
-/// The light of pixel `pixel`'s camera subpath starting along `ray`.
-pub fn radiance(
+/// The light of pixel `pixel`'s camera subpath starting along `ray`, each
+/// strategy's part also told to `tally`.
+pub fn radiance<T: Tally>(
     ctx: &Context,
     light: &LightSide,
     pixel: usize,
     ray: Ray,
     sampler: &mut Sampler,
     counters: &mut Counters,
+    tally: &mut T,
 ) -> Rgb {
     let (world, s) = (ctx.world, &ctx.strategies);
     let scope = PathScope::new(world, ray.origin);
@@ -90,7 +93,9 @@ pub fn radiance(
         counters.rays += 1;
         let Some(hit) = scope.intersect(&ray) else {
             let weight = background_weight(ctx, &partials, length, specular_path, last_point, ray.direction);
-            color += throughput * world.background * weight;
+            let value = throughput * world.background * weight;
+            tally.add(Strategy::Connect { length, light_vertices: 0 }, value, weight);
+            color += value;
             break;
         };
         let (wo, n) = (-ray.direction, hit.surface.normal);
@@ -101,7 +106,10 @@ pub fn radiance(
         partials.arrive(s, Some(distance * distance), wo.dot(n));
         let emitted = world.emitted(&hit, wo);
         if emitted != Rgb::ZERO {
-            color += throughput * emitted * emitter_weight(ctx, &partials, length, specular_path, &hit, wo, last_point);
+            let weight = emitter_weight(ctx, &partials, length, specular_path, &hit, wo, last_point);
+            let value = throughput * emitted * weight;
+            tally.add(Strategy::Connect { length, light_vertices: 0 }, value, weight);
+            color += value;
         }
         // Light tracing's camera paths only see what shines straight at them
         let bsdf = Bsdf::new(world.material_of(&hit));
@@ -112,16 +120,24 @@ pub fn radiance(
         if !bsdf.is_specular() {
             let vertex = CameraVertex { hit: &hit, wo, facing, bsdf: &bsdf, partials: &partials, length };
             if s.connect {
-                color += throughput * direct(ctx, &scope, &vertex, sampler, counters);
+                let (value, weight) = direct(ctx, &scope, &vertex, sampler, counters);
+                tally.add(Strategy::Connect { length: length + 1, light_vertices: 1 }, throughput * value, weight);
+                color += throughput * value;
                 for light_vertex in light.paths.path(pixel) {
                     if light_vertex.length + 1 + length > ctx.max_length {
                         break;
                     }
-                    color += throughput * connect(ctx, &scope, &vertex, light_vertex, counters);
+                    let (value, weight) = connect(ctx, &scope, &vertex, light_vertex, counters);
+                    let strategy = Strategy::Connect {
+                        length: light_vertex.length + 1 + length,
+                        light_vertices: light_vertex.length + 1,
+                    };
+                    tally.add(strategy, throughput * value, weight);
+                    color += throughput * value;
                 }
             }
             if s.merge {
-                color += throughput * merge(ctx, light, &vertex, counters);
+                color += merge(ctx, light, &vertex, throughput, counters, tally);
             }
         }
         let Some(scattered) = bsdf.sample(wo, n, sampler, Transport::Radiance) else { break };
@@ -196,21 +212,23 @@ fn background_weight(
     mis::hit_light(&ctx.strategies, partials, direct, emission)
 }
 
-/// Next-event estimation (s = 1): a light chosen by power, a sample of it.
+/// Next-event estimation (s = 1): a light chosen by power, a sample of it;
+/// its contribution and MIS weight.
 fn direct(
     ctx: &Context,
     scope: &PathScope,
     vertex: &CameraVertex,
     sampler: &mut Sampler,
     counters: &mut Counters,
-) -> Rgb {
-    let Some((index, pick)) = ctx.picker.pick(sampler.next_f32()) else { return Rgb::ZERO };
+) -> (Rgb, f32) {
+    let none = (Rgb::ZERO, 0.0);
+    let Some((index, pick)) = ctx.picker.pick(sampler.next_f32()) else { return none };
     let light = &ctx.world.lights[index];
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
     let shade = |sample: &LightSample| Some(bsdf.eval(wo, sample.wi, facing)).filter(|f| *f != Rgb::ZERO);
     counters.connections += 1;
     let Some((sample, f)) = scope.light_sample(light, vertex.hit, sampler.next_2d(), counters, shade) else {
-        return Rgb::ZERO;
+        return none;
     };
     let point = vertex.hit.surface.point;
     let (direct_pdf, cos_at_light) = match light {
@@ -228,29 +246,31 @@ fn direct(
     let cos = sample.wi.dot(facing);
     let (s, partials) = (&ctx.strategies, vertex.partials);
     let weight = mis::direct(s, partials, bsdf_pdf, reverse, pick, direct_pdf, emission_pdf, cos, cos_at_light);
-    f * sample.value * (cos * weight / pick)
+    (f * sample.value * (cos * weight / pick), weight)
 }
 
-/// A camera vertex connected to a vertex of the pixel's light subpath.
+/// A camera vertex connected to a vertex of the pixel's light subpath:
+/// its contribution and MIS weight.
 fn connect(
     ctx: &Context,
     scope: &PathScope,
     vertex: &CameraVertex,
     light: &LightVertex,
     counters: &mut Counters,
-) -> Rgb {
+) -> (Rgb, f32) {
+    let none = (Rgb::ZERO, 0.0);
     let to_light = light.hit.point - vertex.hit.surface.point;
     let distance2 = to_light.length_squared();
     let direction = to_light / distance2.sqrt();
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
     let camera_f = bsdf.eval(wo, direction, facing);
     if camera_f == Rgb::ZERO {
-        return Rgb::ZERO;
+        return none;
     }
     let light_facing = light.facing();
     let light_f = light.bsdf.eval(light.wo, -direction, light_facing);
     if light_f == Rgb::ZERO {
-        return Rgb::ZERO;
+        return none;
     }
     let (cos_camera, cos_light) = (direction.dot(facing), -direction.dot(light_facing));
     let (camera_go_on, light_go_on) = (bsdf.continuation(), light.bsdf.continuation());
@@ -266,15 +286,24 @@ fn connect(
     counters.rays += 1;
     let (shadow, t_max) = vertex.hit.surface.spawn_ray_to(light.hit.point, light.hit.error);
     if contribution == Rgb::ZERO || ctx.blocked(scope.held && light.held, &shadow, t_max) {
-        return Rgb::ZERO;
+        return none;
     }
-    contribution
+    (contribution, weight)
 }
 
 /// Every light vertex within the merge radius, merged into the camera
-/// vertex: the light it brings, as a density estimate on the radius's disc.
-fn merge(ctx: &Context, light: &LightSide, vertex: &CameraVertex, counters: &mut Counters) -> Rgb {
+/// vertex: the light it brings (times `throughput`), as a density estimate
+/// on the radius's disc.
+fn merge<T: Tally>(
+    ctx: &Context,
+    light: &LightSide,
+    vertex: &CameraVertex,
+    throughput: Rgb,
+    counters: &mut Counters,
+    tally: &mut T,
+) -> Rgb {
     let Some(tree) = light.tree else { return Rgb::ZERO };
+    let normalization = ctx.strategies.vm_normalization;
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
     let go_on = bsdf.continuation();
     let mut sum = Rgb::ZERO;
@@ -292,8 +321,11 @@ fn merge(ctx: &Context, light: &LightSide, vertex: &CameraVertex, counters: &mut
         let camera_reverse = bsdf.pdf(light_vertex.wo, wo, facing) * light_vertex.bsdf.continuation();
         let s = &ctx.strategies;
         let weight = mis::merge(s, &light_vertex.partials, vertex.partials, camera_pdf, camera_reverse);
-        sum += light_vertex.throughput * f * weight;
+        let value = light_vertex.throughput * f * weight;
+        let strategy = Strategy::Merge { length: light_vertex.length + vertex.length, camera_vertex: vertex.length };
+        tally.add(strategy, throughput * value * normalization, weight);
+        sum += value;
         counters.merges += 1;
     });
-    sum * ctx.strategies.vm_normalization
+    throughput * sum * normalization
 }

@@ -9,6 +9,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::mis::{self, Partials};
+use super::strategies::{Contribution, PixelTally, Strategy, Tally};
 use super::Context;
 use crate::geometry::SurfaceHit;
 use crate::render::film::Splat;
@@ -60,6 +61,8 @@ pub struct LightPaths {
     pub ends: Vec<u32>,
     /// Joins to the camera, by chunk in the order of the paths.
     pub splats: Vec<Vec<Splat>>,
+    /// The same, by strategy, where the strategy view asked for them.
+    pub contributions: Vec<Vec<Contribution>>,
     pub counters: Counters,
 }
 
@@ -98,13 +101,19 @@ pub fn trace(
             Some(out)
         })
         .collect();
-    let mut paths =
-        LightPaths { vertices: Vec::new(), ends: Vec::new(), splats: Vec::new(), counters: Counters::default() };
+    let mut paths = LightPaths {
+        vertices: Vec::new(),
+        ends: Vec::new(),
+        splats: Vec::new(),
+        contributions: Vec::new(),
+        counters: Counters::default(),
+    };
     for chunk in per_chunk? {
         let offset = paths.vertices.len() as u32;
         paths.ends.extend(chunk.ends.iter().map(|end| end + offset));
         paths.vertices.extend(chunk.vertices);
         paths.splats.push(chunk.splats);
+        paths.contributions.push(chunk.contributions);
         paths.counters.add(&chunk.counters);
     }
     paths.counters.light_vertices = paths.vertices.len() as u64;
@@ -116,6 +125,7 @@ struct ChunkPaths {
     vertices: Vec<LightVertex>,
     ends: Vec<u32>,
     splats: Vec<Splat>,
+    contributions: Vec<Contribution>,
     counters: Counters,
 }
 
@@ -203,4 +213,9 @@ fn join_camera(ctx: &Context, scope: &PathScope, vertex: &LightVertex, sampler: 
         return;
     }
     out.splats.push(Splat { x: seen.pixel.0, y: seen.pixel.1, value });
+    if let Some(film) = ctx.strategy_film {
+        let pixel = film.pixel(seen.pixel.0, seen.pixel.1);
+        let strategy = Strategy::Connect { length: vertex.length + 1, light_vertices: vertex.length + 1 };
+        PixelTally { pixel, out: &mut out.contributions }.add(strategy, value, weight);
+    }
 }

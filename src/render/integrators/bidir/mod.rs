@@ -16,6 +16,7 @@
 pub mod camera_paths;
 pub mod light_paths;
 pub mod mis;
+pub mod strategies;
 
 use rayon::prelude::*;
 
@@ -31,6 +32,7 @@ use crate::render::world::light::LightSource;
 use crate::render::world::World;
 use camera_paths::{LightSide, MergePoint};
 use mis::Strategies;
+use strategies::{Contribution, NoTally, PixelTally, StrategyFilm};
 
 /// Bidirectional work of one pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -64,6 +66,8 @@ pub struct Bidir {
     max_length: u32,
     seed: u64,
     picker: LightPicker,
+    /// What each strategy brought so far, while the view asks for it.
+    strategies: Option<StrategyFilm>,
 }
 
 /// What the subpaths of a pass share.
@@ -80,6 +84,8 @@ pub struct Context<'a> {
     /// Plain light tracing: joins to the camera weigh 1, camera paths only
     /// see lights straight on.
     pub light_tracing: bool,
+    /// Where the strategy view's contributions go, if it is open.
+    pub strategy_film: Option<&'a StrategyFilm>,
 }
 
 impl Context<'_> {
@@ -98,7 +104,7 @@ impl Context<'_> {
 
 impl Bidir {
     /// For `settings`' method (one of the four) on `world`; the merge
-    /// radius, when the settings leave it, is 1% of what the camera sees.
+    /// radius, when the settings leave it, is 2% of what the camera sees (as SPPM starts).
     pub fn new(world: &World, settings: &RenderSettings, visible_radius: f32) -> Self {
         let (mode, heuristic, radius, alpha) = match &settings.method {
             Method::Bdpt(b) => (Mode::Connect, b.mis, 0.0, 1.0),
@@ -106,7 +112,7 @@ impl Bidir {
             Method::Vcm(m) => (Mode::ConnectAndMerge, m.mis, m.radius, m.alpha),
             _ => (Mode::LightTracing, MisHeuristic::Power, 0.0, 1.0),
         };
-        let radius = if radius > 0.0 { radius } else { (visible_radius * 0.01).max(1e-6) };
+        let radius = if radius > 0.0 { radius } else { (visible_radius * 0.02).max(1e-6) };
         Self {
             mode,
             heuristic,
@@ -115,6 +121,7 @@ impl Bidir {
             max_length: settings.max_depth.max(1),
             seed: settings.seed,
             picker: LightPicker::new(world),
+            strategies: None,
         }
     }
 
@@ -142,9 +149,19 @@ impl Bidir {
 
     /// One pass: the light subpaths, then the camera subpaths tile by tile,
     /// then the light subpaths' joins to the camera. None if abandoned.
-    pub fn pass(&self, stage: &Stage, film: &mut Film, pass: u32, observer: &dyn PassObserver) -> Option<PassReport> {
+    pub fn pass(
+        &mut self,
+        stage: &Stage,
+        film: &mut Film,
+        pass: u32,
+        observer: &dyn PassObserver,
+    ) -> Option<PassReport> {
         let world = stage.world;
         let pixels = film.width as u64 * film.height as u64;
+        if observer.wants_strategies() && self.strategies.is_none() {
+            self.strategies = Some(StrategyFilm::new(film.width, film.height));
+        }
+        let mut strategy_film = self.strategies.take();
         let strategies = self.strategies(pass, pixels as f32);
         let background = world.lights.iter().position(|l| matches!(l, LightSource::Background { .. }));
         let ctx = Context {
@@ -156,6 +173,7 @@ impl Bidir {
             background,
             max_length: self.max_length,
             light_tracing: self.mode == Mode::LightTracing,
+            strategy_film: strategy_film.as_ref(),
         };
         let keep_going = || observer.is_current();
         let paths = light_paths::trace(&ctx, pixels, pass as u64, self.seed, &keep_going)?;
@@ -166,25 +184,32 @@ impl Bidir {
         let light = LightSide { paths: &paths, tree: tree.as_ref(), radius: self.merge_radius(pass) };
         let streams = stage.streams(pass as u64);
         let width = film.width;
-        let per_tile: Vec<Counters> = film
+        let per_tile: Vec<(Counters, Vec<Contribution>)> = film
             .tiles
             .par_iter_mut()
             .with_max_len(1)
             .map(|tile| {
-                let mut counters = Counters::default();
+                let (mut counters, mut contributions) = (Counters::default(), Vec::new());
                 if !observer.is_current() {
-                    return counters;
+                    return (counters, contributions);
                 }
                 let camera_tile = CameraTile { camera: stage.camera, rect: tile.rect, streams };
                 for i in 0..tile.rect.pixels() {
                     let (x, y) = tile.rect.pixel(i);
                     let (ray, mut sampler) = camera_tile.sample(i);
                     let pixel = (y * width + x) as usize;
-                    let value = camera_paths::radiance(&ctx, &light, pixel, ray, &mut sampler, &mut counters);
-                    let value = stage.accept(value, &mut counters).unwrap_or_default();
+                    let (sampler, counters) = (&mut sampler, &mut counters);
+                    let value = match ctx.strategy_film {
+                        Some(small) => {
+                            let mut tally = PixelTally { pixel: small.pixel(x, y), out: &mut contributions };
+                            camera_paths::radiance(&ctx, &light, pixel, ray, sampler, counters, &mut tally)
+                        }
+                        None => camera_paths::radiance(&ctx, &light, pixel, ray, sampler, counters, &mut NoTally),
+                    };
+                    let value = stage.accept(value, counters).unwrap_or_default();
                     tile.add(i, value);
                 }
-                counters
+                (counters, contributions)
             })
             .collect();
         if !observer.is_current() {
@@ -192,9 +217,19 @@ impl Bidir {
         }
         let mut report = PassReport::default();
         report.counters.add(&paths.counters);
-        for counters in &per_tile {
+        for (counters, _) in &per_tile {
             report.counters.add(counters);
         }
+        if let Some(small) = &mut strategy_film {
+            // In the order of the work: tiles, then the light paths' chunks
+            per_tile.iter().for_each(|(_, contributions)| small.add(contributions));
+            paths.contributions.iter().for_each(|contributions| small.add(contributions));
+            small.passes += 1;
+            if strategies::due(pass) {
+                observer.strategies(small.images());
+            }
+        }
+        self.strategies = strategy_film;
         // The joins to the camera, each accepted as a sample is
         let mut rejected = Counters::default();
         let splats: Vec<Vec<_>> = (paths.splats.iter())
