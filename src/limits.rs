@@ -80,6 +80,8 @@ pub const EXPOSURE_STOPS: Limit<f32> = Limit::inclusive(-64.0, 64.0);
 pub const MAX_DEPTH: Limit<u32> = Limit::inclusive(1, 1024);
 /// Worker threads; 0 means one per core.
 pub const THREADS: Limit<usize> = Limit::inclusive(0, 256);
+/// Shards one render is split into (`render --shard`, `farm`).
+pub const SHARDS: Limit<u32> = Limit::inclusive(1, 10_000);
 pub const TILE_SIZE: Limit<u32> = Limit::inclusive(4, 512);
 /// Photons emitted for one map, or in one SPPM pass (28 bytes each stored).
 pub const PHOTONS: Limit<u32> = Limit::inclusive(0, 50_000_000);

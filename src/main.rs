@@ -26,6 +26,9 @@ fn main() -> ExitCode {
         Some(Command::Photons(args)) => gi_studio::cli::photons::run(args),
         Some(Command::Reference(args)) => gi_studio::cli::reference::run(args),
         Some(Command::Bench(args)) => gi_studio::cli::bench::run(args),
+        Some(Command::Merge(args)) => gi_studio::cli::merge::run(args),
+        Some(Command::Compare(args)) => gi_studio::cli::merge::compare(args),
+        Some(Command::Farm(args)) => gi_studio::cli::farm::run(args),
         None => gi_studio::app::run(cli.studio),
     };
     // Errors are reported once, here, as a user reads them (no backtrace)

@@ -3,10 +3,13 @@
 //! against `crate::limits` as it is parsed.
 
 pub mod bench;
+pub mod farm;
+pub mod merge;
 pub mod outputs;
 pub mod photons;
 pub mod reference;
 pub mod render;
+pub mod shard;
 
 use clap::{Args, Parser, Subcommand};
 
@@ -31,6 +34,12 @@ pub enum Command {
     Reference(reference::ReferenceArgs),
     /// Speed against error: every algorithm for the same time budget, against references.
     Bench(bench::BenchArgs),
+    /// Join the partials of a render split by `render --shard` into one image.
+    Merge(merge::MergeArgs),
+    /// How far one image is from another (relMSE, RMSE, the largest difference).
+    Compare(merge::CompareArgs),
+    /// Scripts that render a scene as shards on a SLURM or Kubernetes cluster, then merge them.
+    Farm(farm::FarmArgs),
 }
 
 /// Flags shared by every command that renders.
@@ -165,7 +174,7 @@ pub struct BidirFlags {
     /// How strategies are weighed: power or balance (bdpt, bpm, vcm).
     #[arg(long)]
     pub mis: Option<MisHeuristic>,
-    /// Merge radius at the first pass (bpm, vcm; 0 = 1% of the scene's size).
+    /// Merge radius at the first pass (bpm, vcm; 0 = 2% of the scene's size).
     #[arg(long, value_parser = |s: &str| limits::LENGTH.parse(s))]
     pub merge_radius: Option<f32>,
     /// Merge radius reduction α in (0, 1] (bpm, vcm).

@@ -9,13 +9,16 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::outputs::Outputs;
+use super::shard::{manifest_path, Partial, ShardManifest, ShardSpec};
 use super::RenderFlags;
 use crate::fileio::SIGNATURE;
 use crate::render::image::ImageFormat;
 use crate::render::integrators::photon_map::file::{load_photon_maps, settings_key};
 use crate::render::integrators::photon_map::maps::MapStats;
 use crate::render::integrators::photon_map::PhotonMapStats;
-use crate::render::{Algorithm, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers};
+use crate::render::{
+    Algorithm, LinearImage, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers,
+};
 use crate::scene::{load_scene, Scene};
 
 #[derive(Debug, Args)]
@@ -28,6 +31,10 @@ pub struct RenderArgs {
     /// Reuse photon maps saved by `gi-studio photons` (photon mapping only).
     #[arg(long)]
     pub photon_map: Option<PathBuf>,
+    /// Render shard I of K of the --spp passes, e.g. 0/4, into a partial
+    /// EXR (with its manifest beside it) for `gi-studio merge`.
+    #[arg(long)]
+    pub shard: Option<ShardSpec>,
     #[command(flatten)]
     pub flags: RenderFlags,
 }
@@ -37,6 +44,8 @@ pub struct RenderOutcome {
     pub image: crate::render::LinearImage,
     /// Each pixel's estimated variance (unbiased methods).
     pub variance: Option<crate::render::LinearImage>,
+    /// The odd passes' mean alone (where there is a variance).
+    pub odd: Option<crate::render::LinearImage>,
     pub stats: PassStats,
     pub maps: Option<PhotonMapStats>,
     /// SPPM's mean gather radius after each pass.
@@ -98,11 +107,62 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let keys = (job.scene.content_key(), settings_key(photon, settings.seed, settings.max_depth));
         job.photon_maps = Some(Arc::new(load_photon_maps(path, keys.0, keys.1)?));
     }
+    if let Some(spec) = args.shard {
+        return render_shard(args, spec, job);
+    }
     let outcome = render_with_progress(&args.flags.workers()?, job)?;
     outcome.image.save(&args.output, exposure)?;
     println!("{}", summary_line(&settings, &outcome.stats, &args.output.display().to_string()));
     print_photon_statistics(&outcome);
+    if let Some(line) = paths_line(&outcome.stats) {
+        println!("{line}");
+    }
     Ok(())
+}
+
+/// Render shard `spec` of `job`'s render into a partial at `args.output`.
+fn render_shard(args: &RenderArgs, spec: ShardSpec, mut job: RenderJob) -> Result<()> {
+    if args.output.extension().is_none_or(|e| e != "exr") {
+        bail!("{}: a shard is a partial EXR (for gi-studio merge)", args.output.display());
+    }
+    let mut outputs = Outputs::new(args.flags.force);
+    outputs.input(&args.scene);
+    outputs.claim(&manifest_path(&args.output), &[SIGNATURE.as_bytes()])?;
+    let whole = job.settings.clone();
+    job.settings = spec.settings(&whole)?;
+    let scene = job.scene.clone();
+    let outcome = render_with_progress(&args.flags.workers()?, job)?;
+    let seconds = outcome.stats.elapsed.as_secs_f64();
+    let manifest = ShardManifest::new(&scene, &args.scene.display().to_string(), &whole, spec, seconds);
+    let passes = (manifest.first_pass, manifest.first_pass + manifest.passes);
+    Partial { mean: outcome.image, odd: outcome.odd, manifest }.save(&args.output)?;
+    println!(
+        "shard {}/{}: passes {}..{} of {} in {seconds:.2} s → {}",
+        spec.index,
+        spec.count,
+        passes.0,
+        passes.1,
+        whole.samples_per_pixel.unwrap_or(0),
+        args.output.display()
+    );
+    Ok(())
+}
+
+/// The bidirectional methods' last pass, per light path and per pixel.
+pub fn paths_line(stats: &PassStats) -> Option<String> {
+    let p = &stats.paths;
+    if p.light_paths == 0 {
+        return None;
+    }
+    let per = |n: u64| n as f64 / p.light_paths as f64;
+    let radius = if p.merge_radius > 0.0 { format!(", merge radius {:.4}", p.merge_radius) } else { String::new() };
+    Some(format!(
+        "last pass: {} light paths of {:.2} stored vertices each; per pixel {:.2} connections, {:.2} merges{radius}",
+        p.light_paths,
+        per(p.light_vertices),
+        per(p.connections),
+        per(p.merges)
+    ))
 }
 
 pub fn print_photon_statistics(outcome: &RenderOutcome) {
@@ -196,13 +256,13 @@ pub fn render_with_progress(workers: &Workers, job: RenderJob) -> Result<RenderO
                 bar.set_position(if timed { (stats.elapsed.as_secs_f64() * 10.0) as u64 } else { stats.passes as u64 });
                 bar.set_message(format!("{} spp, {:.2} M samples/s", stats.passes, stats.samples_per_second() / 1e6));
             }
-            RenderEvent::Finished { image, variance, stats, .. } => {
-                let image = Arc::try_unwrap(image).unwrap_or_else(|shared| (*shared).clone());
-                let variance = variance.map(|v| Arc::try_unwrap(v).unwrap_or_else(|shared| (*shared).clone()));
-                break RenderOutcome { image, variance, stats, maps, radii };
+            RenderEvent::Finished { image, variance, odd, stats, .. } => {
+                let owned = |shared: Arc<LinearImage>| Arc::try_unwrap(shared).unwrap_or_else(|s| (*s).clone());
+                let (image, variance, odd) = (owned(image), variance.map(owned), odd.map(owned));
+                break RenderOutcome { image, variance, odd, stats, maps, radii };
             }
             RenderEvent::Failed { message, .. } => bail!("{message}"),
-            RenderEvent::Started { .. } | RenderEvent::Tile(_) => {}
+            RenderEvent::Started { .. } | RenderEvent::Tile(_) | RenderEvent::Strategies { .. } => {}
         }
     };
     bar.finish_and_clear();

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use super::{Reference, ReferenceInfo};
 use crate::fileio::{self, FileError, SIGNATURE};
 use crate::limits;
+use crate::render::layers::encode_layers;
 use crate::render::LinearImage;
 
 #[derive(Debug, thiserror::Error)]
@@ -51,35 +52,9 @@ impl Reference {
 
     /// The EXR's bytes: the image, then the variance layer if there is one.
     pub fn encode(&self) -> Result<Vec<u8>, String> {
-        use exr::prelude::{Encoding, Image, ImageAttributes, IntegerBounds, Layer, LayerAttributes};
-        use exr::prelude::{SpecificChannels, Vec2, WritableImage};
-        let (width, height) = (self.image.width as usize, self.image.height as usize);
-        let layer = |image: &LinearImage, name: &str| {
-            let pixels = image.pixels.clone();
-            let mut attributes = LayerAttributes::named(name);
-            attributes.software_name = Some(SIGNATURE.into());
-            let channels = SpecificChannels::rgb(move |Vec2(x, y): Vec2<usize>| {
-                let [r, g, b] = pixels[y * width + x];
-                (r, g, b)
-            });
-            Layer::new((width, height), attributes, Encoding::FAST_LOSSLESS, channels)
-        };
-        for image in std::iter::once(&self.image).chain(&self.variance) {
-            if image.pixels.len() != width * height
-                || (image.width, image.height) != (self.image.width, self.image.height)
-            {
-                return Err(format!("a {}×{} layer in a {width}×{height} reference", image.width, image.height));
-            }
-        }
-        let attributes = ImageAttributes::new(IntegerBounds::from_dimensions((width, height)));
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        let main = Image::empty(attributes).with_layer(layer(&self.image, "reference"));
-        match &self.variance {
-            Some(variance) => main.with_layer(layer(variance, VARIANCE)).write().to_buffered(&mut bytes),
-            None => main.write().to_buffered(&mut bytes),
-        }
-        .map_err(|e| e.to_string())?;
-        Ok(bytes.into_inner())
+        let mut layers = vec![("reference", &self.image)];
+        layers.extend(self.variance.iter().map(|v| (VARIANCE, v)));
+        encode_layers(&layers)
     }
 
     /// Read a reference: its EXR (a variance layer if it has one) and the
@@ -127,50 +102,13 @@ pub fn load_info(image: &Path) -> Result<ReferenceInfo, ReferenceError> {
     parse_info(&fileio::read_text(&path, limits::TEXT_FILE_BYTES)?, &path)
 }
 
-/// The image layer and the variance layer (if any) of an EXR, after its
-/// header says they are no larger than the program renders.
+/// The image layer and the variance layer (if any) of an EXR.
 fn decode_layers(bytes: &[u8]) -> Result<(LinearImage, Option<LinearImage>), String> {
-    use exr::prelude::{read, ReadChannels, ReadLayers};
-    let meta =
-        exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false).map_err(|e| e.to_string())?;
-    for header in &meta.headers {
-        let (w, h) = (header.layer_size.width() as u64, header.layer_size.height() as u64);
-        if w > limits::IMAGE_SIDE.max as u64 || h > limits::IMAGE_SIDE.max as u64 || w * h > limits::IMAGE_PIXELS {
-            return Err(format!("a {w}×{h} layer, larger than any image this program renders"));
-        }
-    }
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .all_layers()
-        .all_attributes()
-        .from_buffered(std::io::Cursor::new(bytes))
-        .map_err(|e| e.to_string())?;
-    let mut layers = image.layer_data.iter().map(|layer| {
-        let name = layer.attributes.layer_name.as_ref().map(|n| n.to_string()).unwrap_or_default();
-        let (width, height) = (layer.size.width(), layer.size.height());
-        let channel = |wanted: &str| {
-            let found = layer.channel_data.list.iter().find(|c| c.name.to_string().eq_ignore_ascii_case(wanted));
-            found.map(|c| c.sample_data.values_as_f32().collect::<Vec<f32>>())
-        };
-        let (Some(r), Some(g), Some(b)) = (channel("R"), channel("G"), channel("B")) else {
-            return Err(format!("layer “{name}” has no R, G and B channels"));
-        };
-        let pixels: Vec<[f32; 3]> = (0..width * height).map(|i| [r[i], g[i], b[i]]).collect();
-        if let Some(bad) = pixels.iter().flatten().find(|c| !c.is_finite() || **c < 0.0) {
-            return Err(format!("layer “{name}” holds {bad}"));
-        }
-        Ok((name, LinearImage { width: width as u32, height: height as u32, pixels }))
-    });
-    let (_, first) = layers.next().ok_or("no layers")??;
-    let mut variance = None;
-    for layer in layers {
-        let (name, image) = layer?;
-        if name == VARIANCE && (image.width, image.height) == (first.width, first.height) {
-            variance = Some(image);
-        }
-    }
+    let mut layers = crate::render::layers::decode_layers(bytes)?.into_iter();
+    let (_, first) = layers.next().ok_or("no layers")?;
+    let variance = layers
+        .find(|(name, image)| name == VARIANCE && (image.width, image.height) == (first.width, first.height))
+        .map(|(_, image)| image);
     Ok((first, variance))
 }
 

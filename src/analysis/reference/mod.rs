@@ -57,7 +57,12 @@ const REFERENCE_VERSION: u64 = 2;
 /// The key that finds the reference of `scene` at `width × height` made by
 /// `algorithm`: FNV-1a over the scene's content key, the size, the method.
 pub fn reference_key(scene: &Scene, width: u32, height: u32, algorithm: Algorithm) -> String {
-    let words = [scene.content_key(), width as u64, height as u64, REFERENCE_VERSION];
+    reference_key_of(scene.content_key(), width, height, algorithm)
+}
+
+/// `reference_key` of a scene known by its content key (`Scene::content_key`).
+pub fn reference_key_of(content_key: u64, width: u32, height: u32, algorithm: Algorithm) -> String {
+    let words = [content_key, width as u64, height as u64, REFERENCE_VERSION];
     let bytes = words.iter().flat_map(|w| w.to_le_bytes()).chain(algorithm.name().bytes());
     let hash = bytes.fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
     format!("{hash:016x}")
