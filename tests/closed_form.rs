@@ -229,14 +229,16 @@ fn floor_under_a_light_poking_through_the_ceiling() {
 /// radiance is ρ·L (the sky fills the hemisphere above, irradiance πL),
 /// found by sampling the background as a light with multiple importance
 /// sampling against the BSDF (path tracing), by sampling it alone (photon
-/// mapping and SPPM, whose photons find nothing more to carry here). Eight
+/// mapping and SPPM, whose photons find nothing more to carry here), and
+/// by paths leaving the sky's disc too (light tracing, BDPT, VCM). Eight
 /// replicas each, a t-test of their means at 1e-4 (t₇ = 8.0).
 #[test]
 fn a_floor_under_a_white_sky_reflects_its_albedo() {
     let (albedo, sky) = (0.6f32, 1.5f32);
     let mut scene = floor_scene(albedo, vec![]);
     scene.background = Vec3::splat(sky);
-    for algorithm in [Algorithm::Path, Algorithm::Photon, Algorithm::Sppm] {
+    let algorithms = [Algorithm::Path, Algorithm::Photon, Algorithm::Sppm, Algorithm::LightTracing, Algorithm::Bdpt];
+    for algorithm in algorithms.into_iter().chain([Algorithm::Vcm]) {
         let mut s = settings(algorithm, 24, 18, 16);
         s.set_photons(10_000);
         let means: Vec<f64> =

@@ -35,7 +35,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 10.0, value_parser = |s: &str| limits::SECONDS.parse(s))]
     pub budget: f64,
     /// Comma-separated algorithms.
-    #[arg(long, value_delimiter = ',', default_value = "whitted,path,photon,sppm")]
+    #[arg(long, value_delimiter = ',', default_value = "whitted,path,photon,sppm,lt,bdpt,bpm,vcm")]
     pub algos: Vec<Algorithm>,
     /// A folder of references named <scene>.exr to use instead of the
     /// built-in ones and the reference cache.

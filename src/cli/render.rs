@@ -32,7 +32,11 @@ pub struct RenderArgs {
     #[arg(long)]
     pub photon_map: Option<PathBuf>,
     /// Render shard I of K of the --spp passes, e.g. 0/4, into a partial
-    /// EXR (with its manifest beside it) for `gi-studio merge`.
+    /// EXR (with its manifest beside it) for `gi-studio merge`. Whitted,
+    /// path, photon, lt and bdpt take passes [I·N/K, (I+1)·N/K) of one
+    /// render (merged exactly); sppm, bpm and vcm, whose passes build on
+    /// each other, run N/K passes of their own with a seed of their own
+    /// (merged by weighting).
     #[arg(long)]
     pub shard: Option<ShardSpec>,
     #[command(flatten)]

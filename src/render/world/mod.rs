@@ -64,6 +64,32 @@ pub struct World {
     pub(crate) light_plane: Vec<u32>,
 }
 
+/// A ball about `points`' box, half again as wide: (centre, radius).
+fn bounding_ball(points: &[Vec3]) -> Option<(Vec3, f32)> {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for p in points {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    (lo.x <= hi.x).then(|| ((lo + hi) * 0.5, (hi - lo).length() * 0.75))
+}
+
+/// The visible points that say how large the scene is: all of them, but
+/// where the farthest tenth would more than triple the region, those are
+/// left out. A ground plane seen to the horizon puts a few of them hundreds
+/// of units off; a region that size spread an infinite light's photons a
+/// thousand times too thin over what is seen, and made merge radii, which
+/// are fractions of the scene's size, a unit wide in a scene of five (the
+/// far ground then gets its infinite lights' light from path tracing's
+/// strategies alone).
+fn region_points(points: Vec<Vec3>) -> Vec<Vec3> {
+    let near = nearest_nine_tenths(&points);
+    match (bounding_ball(&points), bounding_ball(&near)) {
+        (Some(all), Some(few)) if all.1 > 3.0 * few.1 => near,
+        _ => points,
+    }
+}
+
 /// The nine in ten of `points` nearest their median (per axis).
 fn nearest_nine_tenths(points: &[Vec3]) -> Vec<Vec3> {
     let median = |axis: usize| {
@@ -337,7 +363,7 @@ impl World {
     /// (`visible_radius`, or the bounds' where it sees nothing).
     pub fn for_view(scene: &ValidScene, camera: &CameraModel, width: u32, height: u32) -> (World, f32) {
         let mut world = World::new(scene);
-        let visible = world.visible_points(camera, width, height);
+        let visible = region_points(world.visible_points(camera, width, height));
         world.cover(&visible, camera);
         let radius = World::visible_radius(&visible).unwrap_or(world.bounds_radius.max(1.0));
         (world, radius)
@@ -375,27 +401,9 @@ impl World {
     /// outside the view, and fit the emitters' caps to what `camera` can see.
     /// The bounds of all finite objects would not do when walls are spheres
     /// of radius 1e5.
-    /// Where the farthest tenth of the visible points would more than
-    /// triple the region, they are left out: a ground plane seen to the
-    /// horizon puts a few of them hundreds of units off, and a region that
-    /// size would spread an infinite light's photons a thousand times too
-    /// thin over what is seen (the far ground then gets its light from the
-    /// other strategies alone).
+    /// `points` are what the camera sees (`region_points`).
     pub fn cover(&mut self, points: &[Vec3], camera: &CameraModel) {
-        let bounds = |points: &[Vec3]| {
-            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-            for p in points {
-                lo = lo.min(*p);
-                hi = hi.max(*p);
-            }
-            (lo.x <= hi.x).then(|| ((lo + hi) * 0.5, (hi - lo).length() * 0.75))
-        };
-        let near = bounds(&nearest_nine_tenths(points));
-        let region = match (bounds(points), near) {
-            (Some(all), Some(near)) if all.1 > 3.0 * near.1 => Some(near),
-            (all, _) => all,
-        };
-        if let Some((center, radius)) = region {
+        if let Some((center, radius)) = bounding_ball(points) {
             self.bounds_center = center;
             self.bounds_radius = radius;
         }

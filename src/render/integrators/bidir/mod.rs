@@ -67,7 +67,7 @@ pub struct Bidir {
     seed: u64,
     picker: LightPicker,
     /// What each strategy brought so far, while the view asks for it.
-    strategies: Option<StrategyFilm>,
+    strategy_film: Option<StrategyFilm>,
 }
 
 /// What the subpaths of a pass share.
@@ -121,7 +121,7 @@ impl Bidir {
             max_length: settings.max_depth.max(1),
             seed: settings.seed,
             picker: LightPicker::new(world),
-            strategies: None,
+            strategy_film: None,
         }
     }
 
@@ -140,8 +140,8 @@ impl Bidir {
         (self.radius / ((pass + 1) as f32).powf(0.5 * (1.0 - self.alpha))).max(1e-7)
     }
 
-    /// The strategies of pass `pass` over `pixels` pixels.
-    fn strategies(&self, pass: u32, pixels: f32) -> Strategies {
+    /// The strategies of pass `pass` over `pixels` pixels, and how they weigh.
+    fn weighing(&self, pass: u32, pixels: f32) -> Strategies {
         let connect = matches!(self.mode, Mode::Connect | Mode::ConnectAndMerge);
         let merge = matches!(self.mode, Mode::Merge | Mode::ConnectAndMerge);
         Strategies::new(self.heuristic, connect, merge, pixels, self.merge_radius(pass))
@@ -158,16 +158,16 @@ impl Bidir {
     ) -> Option<PassReport> {
         let world = stage.world;
         let pixels = film.width as u64 * film.height as u64;
-        if observer.wants_strategies() && self.strategies.is_none() {
-            self.strategies = Some(StrategyFilm::new(film.width, film.height));
+        if observer.wants_strategies() && self.strategy_film.is_none() {
+            self.strategy_film = Some(StrategyFilm::new(film.width, film.height));
         }
-        let mut strategy_film = self.strategies.take();
-        let strategies = self.strategies(pass, pixels as f32);
+        let mut strategy_film = self.strategy_film.take();
+        let weighing = self.weighing(pass, pixels as f32);
         let background = world.lights.iter().position(|l| matches!(l, LightSource::Background { .. }));
         let ctx = Context {
             world,
             camera: stage.camera,
-            strategies,
+            strategies: weighing,
             picker: &self.picker,
             bounds: world.bounds(),
             background,
@@ -177,7 +177,7 @@ impl Bidir {
         };
         let keep_going = || observer.is_current();
         let paths = light_paths::trace(&ctx, pixels, pass as u64, self.seed, &keep_going)?;
-        let tree = strategies.merge.then(|| KdTree::build(MergePoint::of(&paths.vertices)));
+        let tree = weighing.merge.then(|| KdTree::build(MergePoint::of(&paths.vertices)));
         if !observer.is_current() {
             return None;
         }
@@ -229,7 +229,7 @@ impl Bidir {
                 observer.strategies(small.images());
             }
         }
-        self.strategies = strategy_film;
+        self.strategy_film = strategy_film;
         // The joins to the camera, each accepted as a sample is
         let mut rejected = Counters::default();
         let splats: Vec<Vec<_>> = (paths.splats.iter())
@@ -244,24 +244,28 @@ impl Bidir {
             .collect();
         report.counters.non_finite += rejected.non_finite;
         film.add_splats(splats);
-        let mut noise = TermSums::default();
-        for tile in &mut film.tiles {
-            tile.samples += 1;
-            if observer.wants_tiles() {
-                let variance = if observer.wants_variance() { tile.variance() } else { None };
-                observer.tile(tile.rect, tile.mean(), variance);
-            }
-            if observer.wants_noise(pass) {
-                noise.add(&tile.noise_terms());
-            }
-        }
-        report.noise = noise;
+        let noise: Vec<TermSums> = (film.tiles.par_iter_mut())
+            .with_max_len(1)
+            .map(|tile| {
+                tile.samples += 1;
+                if observer.wants_tiles() {
+                    let variance = if observer.wants_variance() { tile.variance() } else { None };
+                    observer.tile(tile.rect, tile.mean(), variance);
+                }
+                if observer.wants_noise(pass) {
+                    tile.noise_terms()
+                } else {
+                    TermSums::default()
+                }
+            })
+            .collect();
+        noise.iter().for_each(|terms| report.noise.add(terms));
         report.paths = PathPassStats {
             light_paths: pixels,
             light_vertices: report.counters.light_vertices,
             connections: report.counters.connections,
             merges: report.counters.merges,
-            merge_radius: if strategies.merge { self.merge_radius(pass) } else { 0.0 },
+            merge_radius: if weighing.merge { self.merge_radius(pass) } else { 0.0 },
         };
         Some(report)
     }
