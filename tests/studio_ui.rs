@@ -438,6 +438,7 @@ fn the_strategy_view_shows_each_strategy_with_its_share() {
     assert!(label.ends_with("% of the pane's light"), "{label}");
     let share: f64 = label.split(": ").nth(1).and_then(|t| t.split('%').next()).and_then(|p| p.parse().ok()).unwrap();
     assert!(share > 0.0 && share < 100.0, "{label}");
+    assert!(harness.query_by_label_contains("merged at camera vertex").is_none(), "BDPT does not merge");
     harness.get_by_label("Strategies").click();
     harness.run_steps(2);
     assert!(harness.query_by_label_contains("(s, t) = (1, 2): ").is_none(), "the view closed");

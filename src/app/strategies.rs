@@ -60,41 +60,63 @@ pub fn strategies_ui(
     pane_light: f64,
 ) {
     let mut open = view.open;
-    egui::Window::new(format!("Strategies of pane {}", index + 1)).open(&mut open).resizable(true).show(ctx, |ui| {
-        let before = view.weighted;
-        ui.horizontal(|ui| {
-            ui.radio_value(&mut view.weighted, true, "weighted (what the image holds)");
-            ui.radio_value(&mut view.weighted, false, "unweighted (each strategy alone)");
-        });
-        if view.weighted != before {
-            view.shown = None;
-        }
-        let Some(images) = images else {
-            ui.weak("Waiting for the first pass…");
-            return;
-        };
-        view.update(ctx, &images, exposure);
-        ui.small(format!(
-            "{} passes; paths of up to {MAX_LENGTH} segments; s: vertices from the light, t: from the camera",
-            images.passes
-        ));
-        let thumb = egui::vec2(images.width as f32, images.height as f32) * (140.0 / images.width.max(1) as f32);
-        egui::ScrollArea::both().show(ui, |ui| {
-            for length in 1..=MAX_LENGTH {
-                ui.horizontal(|ui| {
-                    ui.label(format!("k = {length}"));
-                    for (i, strategy) in images.strategies.iter().enumerate().filter(|(_, s)| s.length() == length) {
-                        let response = ui.image((view.textures[i].id(), thumb));
-                        let light = images.weighted[i].iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>()
-                            / images.weighted[i].len().max(1) as f64;
-                        let share = if pane_light > 0.0 { 100.0 * light / pane_light } else { 0.0 };
-                        let text = format!("{}: {share:.1}% of the pane's light", strategy.label());
-                        response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, &text));
-                        response.on_hover_text(text);
-                    }
-                });
+    egui::Window::new(format!("Strategies of pane {}", index + 1))
+        .open(&mut open)
+        .resizable(true)
+        // Room for the longest row (six strategies of 140 points) and all five rows.
+        .default_size([920.0, 640.0])
+        // At the bottom right, over the plots: not over the pane's buttons,
+        // its own "Strategies" among them.
+        .pivot(egui::Align2::RIGHT_BOTTOM)
+        .default_pos(ctx.content_rect().right_bottom() - egui::vec2(16.0, 16.0))
+        .show(ctx, |ui| {
+            let before = view.weighted;
+            ui.horizontal(|ui| {
+                ui.radio_value(&mut view.weighted, true, "weighted (what the image holds)");
+                ui.radio_value(&mut view.weighted, false, "unweighted (each strategy alone)");
+            });
+            if view.weighted != before {
+                view.shown = None;
             }
+            let Some(images) = images else {
+                ui.weak("Waiting for the first pass…");
+                return;
+            };
+            view.update(ctx, &images, exposure);
+            ui.small(format!(
+                "{} passes; paths of up to {MAX_LENGTH} segments; s: vertices from the light, t: from the camera; \
+             strategies that brought no light yet are left out",
+                images.passes
+            ));
+            let thumb = egui::vec2(images.width as f32, images.height as f32) * (140.0 / images.width.max(1) as f32);
+            egui::ScrollArea::both().show(ui, |ui| {
+                for length in 1..=MAX_LENGTH {
+                    ui.horizontal(|ui| {
+                        ui.label(format!("k = {length}"));
+                        for (i, strategy) in images
+                            .strategies
+                            .iter()
+                            .enumerate()
+                            .filter(|&(i, s)| s.length() == length && images.brought_light[i])
+                        {
+                            let response = ui
+                                .vertical(|ui| {
+                                    let response = ui.image((view.textures[i].id(), thumb));
+                                    ui.small(strategy.label());
+                                    response
+                                })
+                                .inner;
+                            let light =
+                                images.weighted[i].iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>()
+                                    / images.weighted[i].len().max(1) as f64;
+                            let share = if pane_light > 0.0 { 100.0 * light / pane_light } else { 0.0 };
+                            let text = format!("{}: {share:.1}% of the pane's light", strategy.label());
+                            response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, &text));
+                            response.on_hover_text(text);
+                        }
+                    });
+                }
+            });
         });
-    });
     view.open = open;
 }

@@ -154,7 +154,9 @@ impl StrategyFilm {
     pub fn images(&self) -> StrategyImages {
         let scale = 1.0 / (self.passes.max(1) as f64 * (SHRINK * SHRINK) as f64);
         let mean = |sums: &Vec<[f64; 3]>| sums.iter().map(|s| s.map(|c| (c * scale) as f32)).collect();
+        let brought_light = self.unweighted.iter().map(|sums| sums.iter().any(|s| s.iter().any(|&c| c != 0.0)));
         StrategyImages {
+            brought_light: brought_light.collect(),
             width: self.width,
             height: self.height,
             passes: self.passes,
@@ -172,6 +174,10 @@ pub struct StrategyImages {
     pub height: u32,
     pub passes: u32,
     pub strategies: Vec<Strategy>,
+    /// Whether each strategy has brought any light yet: those the method
+    /// does not use (merges in BDPT, the light seen from its own first
+    /// vertex) never do.
+    pub brought_light: Vec<bool>,
     pub weighted: Vec<Vec<[f32; 3]>>,
     pub unweighted: Vec<Vec<[f32; 3]>>,
 }
@@ -198,5 +204,27 @@ mod tests {
         assert_eq!(Strategy::Connect { length: MAX_LENGTH + 1, light_vertices: 0 }.index(), None);
         assert_eq!(Strategy::Merge { length: 3, camera_vertex: 3 }.index(), None);
         assert_eq!(Strategy::Connect { length: 2, light_vertices: 1 }.label(), "(s, t) = (1, 2)");
+    }
+
+    /// A contribution lands on its strategy's small pixel, weighted and
+    /// divided by its weight, averaged over passes and the SHRINK² pane
+    /// pixels it stands for; only strategies that received light say so.
+    #[test]
+    fn contributions_land_on_their_strategy_and_pixel() {
+        let mut film = StrategyFilm::new(2 * SHRINK, SHRINK);
+        let strategy = Strategy::Connect { length: 3, light_vertices: 2 };
+        let mut out = Vec::new();
+        let mut tally = PixelTally { pixel: film.pixel(SHRINK, 0), out: &mut out };
+        tally.add(strategy, Rgb::new(0.5, 1.0, 2.0), 0.25);
+        tally.add(Strategy::Merge { length: 2, camera_vertex: 1 }, Rgb::ZERO, 0.5);
+        film.add(&out);
+        film.passes = 2;
+        let images = film.images();
+        let cell = strategy.index().unwrap();
+        let scale = 1.0 / (2.0 * (SHRINK * SHRINK) as f32);
+        assert_eq!(images.weighted[cell], vec![[0.0; 3], [0.5 * scale, scale, 2.0 * scale]]);
+        assert_eq!(images.unweighted[cell][1], [2.0 * scale, 4.0 * scale, 8.0 * scale]);
+        let lit: Vec<usize> = (0..images.strategies.len()).filter(|&i| images.brought_light[i]).collect();
+        assert_eq!(lit, vec![cell]);
     }
 }
