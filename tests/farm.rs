@@ -209,3 +209,40 @@ fn the_commands_shard_merge_and_write_the_farms_scripts() {
     let (code, text) = run(&["farm", "slurm", &scene, "--shards", "9", "--out", &farm_s, "--", "--spp", "8"]);
     assert_eq!((code, text.contains("9 shards of 8 passes")), (Some(1), true), "{text}");
 }
+
+/// A reference rendered on a farm serves the studio and `bench`: shards at
+/// the reference's size (half the scene's), merged with `--reference`, are
+/// the reference `bench` measures an edited scene against, from another
+/// folder, where without it `bench` refuses.
+#[test]
+fn a_merged_reference_is_the_one_bench_measures_against() {
+    let bin = env!("CARGO_BIN_EXE_gi-studio");
+    let dir = tempfile::tempdir().unwrap();
+    let (d, cache) = (dir.path(), dir.path().join("cache"));
+    let elsewhere = tempfile::tempdir().unwrap();
+    let edited =
+        include_str!("../assets/scenes/cornell.ron").replace("width: 640, height: 480", "width: 64, height: 48");
+    std::fs::write(d.join("edited.ron"), edited).unwrap();
+    let scene = d.join("edited.ron").display().to_string();
+    let run = |args: &[&str], at: &std::path::Path| {
+        let out = Command::new(bin).args(args).current_dir(at).env("XDG_CACHE_HOME", &cache).output().unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+        (out.status.code(), text)
+    };
+    let bench = ["bench", &scene, "--budget", "0.05", "--algos", "path", "--reference-budget", "0", "--out", "bench"];
+    let (code, text) = run(&bench, elsewhere.path());
+    assert_eq!((code, text.contains("no reference for")), (Some(1), true), "{text}");
+    let flags = ["--algo", "path", "--spp", "16", "--width", "32", "--height", "24"];
+    for shard in ["0/2", "1/2"] {
+        let part = format!("part-{}.exr", &shard[..1]);
+        let (code, text) = run(&[&["render", &scene, "-o", &part, "--shard", shard][..], &flags].concat(), d);
+        assert_eq!(code, Some(0), "{text}");
+    }
+    let (code, text) = run(&["merge", "part-0.exr", "part-1.exr", "--reference"], d);
+    assert_eq!((code, text.contains("kept as the reference of")), (Some(0), true), "{text}");
+    let (code, text) = run(&bench, elsewhere.path());
+    assert_eq!(code, Some(0), "{text}");
+    let csv = std::fs::read_to_string(elsewhere.path().join("bench").join("convergence.csv")).unwrap();
+    let relmse: Vec<f64> = csv.lines().skip(1).map(|line| line.split(',').nth(5).unwrap().parse().unwrap()).collect();
+    assert!(!relmse.is_empty() && relmse.iter().all(|e| e.is_finite()), "{csv}");
+}
