@@ -197,7 +197,10 @@ fn a_render_that_never_ends_does_not_hold_back_another_on_the_same_workers() {
 /// A driver that abandons its job at its `after`-th tile and counts the
 /// tiles still finished after that: the work a cancel waits for.
 struct Abandoning {
+    /// Tiles shown before the pass is no longer wanted
     after: usize,
+    /// Or questions asked (for passes that show their tiles only at the end)
+    after_questions: usize,
     tiles: std::sync::atomic::AtomicUsize,
     late: std::sync::atomic::AtomicUsize,
     asked: std::sync::atomic::AtomicUsize,
@@ -205,14 +208,14 @@ struct Abandoning {
 
 impl Abandoning {
     fn new(after: usize) -> Self {
-        Self { after, tiles: 0.into(), late: 0.into(), asked: 0.into() }
+        Self { after, after_questions: usize::MAX, tiles: 0.into(), late: 0.into(), asked: 0.into() }
     }
 }
 
 impl PassObserver for Abandoning {
     fn is_current(&self) -> bool {
-        self.asked.fetch_add(1, Ordering::SeqCst);
-        self.tiles.load(Ordering::SeqCst) < self.after
+        let asked = self.asked.fetch_add(1, Ordering::SeqCst);
+        self.tiles.load(Ordering::SeqCst) < self.after && asked < self.after_questions
     }
     fn wants_tiles(&self) -> bool {
         true
@@ -234,11 +237,14 @@ impl PassObserver for Abandoning {
 /// driver says it is no longer wanted, at most one more tile a worker is
 /// finished (those already started), for every algorithm's pass; and
 /// photon tracing asks before every chunk of photons, so a cancel during a
-/// map of millions waits for one chunk a worker at most.
+/// map of millions waits for one chunk a worker at most. The bidirectional
+/// methods show their tiles only once the light paths' splats are in: they
+/// ask before every chunk of light paths and every tile of camera paths,
+/// and a pass abandoned there shows nothing.
 #[test]
 fn a_cancel_waits_for_at_most_one_tile_or_chunk_a_worker() {
     let workers = Workers::new(2).unwrap();
-    for algorithm in [Algorithm::Whitted, Algorithm::Path, Algorithm::Photon, Algorithm::Sppm] {
+    for algorithm in Algorithm::ALL {
         let job = job("cornell", algorithm, 160, 120, 1);
         let mut settings = job.settings.clone();
         settings.tile_size = 8; // 300 tiles: a cancel at the 20th leaves most undone
@@ -249,9 +255,17 @@ fn a_cancel_waits_for_at_most_one_tile_or_chunk_a_worker() {
         let mut film = Film::new(settings.width, settings.height, settings.tile_size, false);
         let keep = Abandoning::new(usize::MAX);
         let mut integrator = Integrator::prepare(&stage, &film, visible, None, &keep).expect("prepared");
-        let driver = Abandoning::new(20);
+        let driver = if algorithm.is_bidirectional() {
+            Abandoning { after_questions: 20, ..Abandoning::new(usize::MAX) }
+        } else {
+            Abandoning::new(20)
+        };
         let report = workers.run(|| integrator.pass(&stage, &mut film, 0, &driver));
         assert!(report.is_none(), "{algorithm}: an abandoned pass reports nothing");
+        if algorithm.is_bidirectional() {
+            assert_eq!(driver.tiles.load(Ordering::SeqCst), 0, "{algorithm}: an abandoned pass shows no tile");
+            continue;
+        }
         let late = driver.late.load(Ordering::SeqCst);
         assert!(late <= 1, "{algorithm}: {late} tiles finished after the cancel, on 2 workers");
         assert!(driver.tiles.load(Ordering::SeqCst) < 40, "{algorithm}: the pass went on");

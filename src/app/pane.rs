@@ -252,7 +252,7 @@ impl Pane {
 
     /// Whether its algorithm has strategies to show (the bidirectional ones).
     pub fn has_strategies(&self) -> bool {
-        matches!(self.algorithm(), Algorithm::LightTracing | Algorithm::Bdpt | Algorithm::Bpm | Algorithm::Vcm)
+        self.algorithm().is_bidirectional()
     }
 
     pub fn strategy_view_mut(&mut self) -> &mut StrategyView {

@@ -66,6 +66,13 @@ impl Algorithm {
         !matches!(self, Algorithm::Sppm | Algorithm::Bpm | Algorithm::Vcm)
     }
 
+    /// Whether it traces paths from both ends (one strategy set of
+    /// `integrators::bidir`): its tiles are final only once the light
+    /// paths' splats are in, at the end of a pass.
+    pub fn is_bidirectional(self) -> bool {
+        matches!(self, Algorithm::LightTracing | Algorithm::Bdpt | Algorithm::Bpm | Algorithm::Vcm)
+    }
+
     /// Whether its passes are independent unbiased estimates of the
     /// converged image: then the spread between them is its error, and the
     /// film keeps its odd passes apart to measure it.
