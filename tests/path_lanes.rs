@@ -35,7 +35,7 @@ fn world(scene: &Scene, width: u32, height: u32) -> (World, CameraModel) {
 fn assert_lanes_match_scalar(scene: &Scene, max_depth: u32, passes: u64) -> usize {
     let (width, height) = (40, 30);
     let (world, camera) = world(scene, width, height);
-    let lanes = PathLanes::new(&world).expect("a scene of spheres");
+    let lanes = PathLanes::new(&world).expect("a scene the lanes trace");
     let whole = TileRect { x: 0, y: 0, width, height };
     // 13 × 7: rows that do not split into eights, away from the origin
     let ragged = TileRect { x: 21, y: 17, width: 13, height: 7 };
@@ -105,6 +105,13 @@ fn other_lights_bit_for_bit() {
     glow.name = "glow".into();
     glow.shape = gi_studio::scene::Shape::Sphere { center: Vec3::new(60.0, 40.0, 100.0), radius: 4.0 };
     scene.objects.push(glow);
+    // And a glowing triangle facing down: caps, triangles and whole spheres
+    // drawn in one batch of lanes
+    let mut panel = scene.objects[8].clone();
+    panel.name = "panel".into();
+    let (a, b, c) = (Vec3::new(20.0, 70.0, 60.0), Vec3::new(40.0, 70.0, 60.0), Vec3::new(30.0, 70.0, 80.0));
+    panel.shape = gi_studio::scene::Shape::Triangle { a, b, c };
+    scene.objects.push(panel);
     assert_lanes_match_scalar(&scene, 32, 2);
     scene.lights.push(light(LightKind::Directional { direction: Vec3::new(0.1, -1.0, 0.3) }, 1.0));
     assert_lanes_match_scalar(&scene, 32, 1);
@@ -134,12 +141,54 @@ fn paths_end_on_black_surfaces() {
     assert!(lit > 0, "the light is in view");
 }
 
+/// Planes (walls and not) and triangles (lights among them, shadow rays
+/// skipping the light's own plane), with area, point, spot and
+/// directional lights: every preset the lanes take.
 #[test]
-fn only_scenes_of_spheres_take_lanes() {
-    let (cornell, _) = world(&preset("cornell"), 8, 6);
-    assert!(PathLanes::new(&cornell).is_none());
-    let (smallpt, _) = world(&preset("smallpt"), 8, 6);
-    assert!(PathLanes::new(&smallpt).is_some());
+fn presets_of_planes_and_triangles_bit_for_bit() {
+    for (name, least) in
+        [("cornell", 1500), ("caustics", 1500), ("gap-room", 200), ("lights", 1500), ("mirror-caustic", 1000)]
+    {
+        let lit = assert_lanes_match_scalar(&preset(name), 32, 2);
+        assert!(lit > least, "{name}: only {lit} samples carried light");
+    }
+}
+
+/// Paths that start outside a wall (a wide lens beside the Cornell box's
+/// right wall: some rays start beyond it) meet every plane from either
+/// side and test walls for their shadow rays, beside paths held inside.
+#[test]
+fn paths_outside_the_walls_bit_for_bit() {
+    let mut scene = preset("cornell");
+    scene.camera.position = Vec3::new(0.9, 1.0, 3.4);
+    scene.camera.aperture_radius = 0.3;
+    scene.camera.focus_distance = 3.0;
+    let (world, camera) = world(&scene, 40, 30);
+    let tile = CameraTile {
+        camera: &camera,
+        rect: TileRect { x: 0, y: 0, width: 40, height: 30 },
+        streams: PassStreams::new(0, 7),
+    };
+    let outside = (0..tile.len()).filter(|&i| !world.holds(tile.sample(i).0.origin)).count();
+    assert!(outside > 100 && outside < tile.len() - 100, "{outside} of {} rays start outside", tile.len());
+    let lit = assert_lanes_match_scalar(&scene, 32, 2);
+    assert!(lit > 500, "only {lit} samples carried light");
+}
+
+/// Materials the lanes do not run (Phong, Blinn–Phong) and the background
+/// as a light send a scene to the scalar tracer.
+#[test]
+fn other_scenes_take_the_scalar_tracer() {
+    for (name, lanes) in
+        [("cornell", true), ("smallpt", true), ("gap-room", true), ("glossy", false), ("thesis", false)]
+    {
+        let (world, _) = world(&preset(name), 8, 6);
+        assert_eq!(PathLanes::new(&world).is_some(), lanes, "{name}");
+    }
+    let mut sky = preset("cornell");
+    sky.background = Rgb::new(0.2, 0.3, 0.4);
+    let (world, _) = world(&sky, 8, 6);
+    assert!(PathLanes::new(&world).is_none(), "a sky");
 }
 
 /// The tests above compare the eight lanes with the scalar code only where

@@ -1,5 +1,6 @@
 use glam::Vec3;
 
+use super::real::{Mask, Real, V3};
 use super::{gamma, Ray, SurfaceHit};
 
 /// Hit of `ray` with the infinite plane `normal · x = offset` in (0, t_max).
@@ -12,12 +13,18 @@ pub fn intersect_plane(ray: &Ray, normal: Vec3, offset: f32, t_max: f32) -> Opti
 
 #[inline]
 pub(crate) fn plane_t(ray: &Ray, normal: Vec3, offset: f32, t_max: f32) -> Option<f32> {
-    let denominator = normal.dot(ray.direction);
-    if denominator == 0.0 {
-        return None;
-    }
-    let t = (offset - normal.dot(ray.origin)) / denominator;
-    (t > 0.0 && t < t_max).then_some(t)
+    let (t, hits) = plane_t_of(V3::from(ray.origin), V3::from(ray.direction), V3::from(normal), offset, t_max);
+    hits.then_some(t)
+}
+
+/// `plane_t` in any lanes: t, and where it lies in (0, t_max) (nowhere
+/// for a ray parallel to the plane).
+#[inline(always)]
+pub(crate) fn plane_t_of<R: Real>(origin: V3<R>, direction: V3<R>, normal: V3<R>, offset: R, t_max: R) -> (R, R::Mask) {
+    let zero = R::splat(0.0);
+    let denominator = normal.dot(direction);
+    let t = (offset - normal.dot(origin)) / denominator;
+    (t, denominator.ne(zero).and(t.gt(zero)).and(t.lt(t_max)))
 }
 
 /// Where a ray leaves the half-space `inward · x > offset` that holds its
@@ -26,20 +33,38 @@ pub(crate) fn plane_t(ray: &Ray, normal: Vec3, offset: f32, t_max: f32) -> Optio
 /// on the far side heading out; see `sphere::wall_exit`.
 #[inline]
 pub(crate) fn plane_exit_t(ray: &Ray, inward: Vec3, offset: f32, t_max: f32) -> Option<f32> {
-    let denominator = inward.dot(ray.direction);
-    if denominator >= 0.0 {
-        return None;
-    }
-    let t = ((offset - inward.dot(ray.origin)) / denominator).max(0.0);
-    (t < t_max).then_some(t)
+    let (t, exits) = plane_exit_of(V3::from(ray.origin), V3::from(ray.direction), V3::from(inward), offset, t_max);
+    exits.then_some(t)
+}
+
+/// `plane_exit_t` in any lanes: t, and where the ray leaves before t_max.
+#[inline(always)]
+pub(crate) fn plane_exit_of<R: Real>(
+    origin: V3<R>,
+    direction: V3<R>,
+    inward: V3<R>,
+    offset: R,
+    t_max: R,
+) -> (R, R::Mask) {
+    let zero = R::splat(0.0);
+    let denominator = inward.dot(direction);
+    let t = ((offset - inward.dot(origin)) / denominator).max(zero);
+    (t, t.lt(t_max).and_not(denominator.ge(zero)))
 }
 
 #[inline]
 pub(crate) fn plane_hit(ray: &Ray, normal: Vec3, offset: f32, t: f32) -> SurfaceHit {
+    let (point, error) = plane_point_of(V3::from(ray.origin), V3::from(ray.direction), V3::from(normal), offset, t);
+    SurfaceHit { t, point: point.into(), normal, error }
+}
+
+/// The point of `plane_hit` in any lanes, and the bound on its error.
+#[inline(always)]
+pub(crate) fn plane_point_of<R: Real>(origin: V3<R>, direction: V3<R>, normal: V3<R>, offset: R, t: R) -> (V3<R>, R) {
     // Re-project onto the plane so the error does not grow with t
-    let along = ray.at(t);
+    let along = origin + direction * t;
     let point = along - normal * (normal.dot(along) - offset);
-    SurfaceHit { t, point, normal, error: gamma(7) * (point.abs().element_sum() + offset.abs()) }
+    (point, R::splat(gamma(7)) * (point.abs().element_sum() + offset.abs()))
 }
 
 #[cfg(test)]

@@ -1,5 +1,6 @@
 use glam::{DVec3, Vec3};
 
+use super::real::{Mask, Real, V3};
 use super::{gamma, Ray, SurfaceHit};
 
 /// A triangle with its geometric normal precomputed; a degenerate one (zero
@@ -36,6 +37,11 @@ impl Triangle {
         self.area
     }
 
+    /// The ball holding it, as `may_reach` tests it: (centre, radius).
+    pub fn bound(&self) -> (Vec3, f32) {
+        (self.bound_center, self.bound_radius)
+    }
+
     /// Whether `other` lies in this triangle's plane, to within rounding.
     pub fn holds_in_plane(&self, other: &Triangle) -> bool {
         let (normal, a) = (self.normal.as_dvec3(), self.vertices[0].as_dvec3());
@@ -66,12 +72,18 @@ pub fn intersect_triangle(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<
 /// watertight).
 #[inline]
 fn may_reach(ray: &Ray, center: Vec3, radius: f32, t_max: f32) -> bool {
-    let f = ray.origin - center;
-    let b = f.dot(ray.direction);
-    let closest = f - b * ray.direction;
-    let reach = radius + gamma(16) * (f.abs().element_sum() + radius);
+    may_reach_of(V3::from(ray.origin), V3::from(ray.direction), V3::from(center), radius, t_max)
+}
+
+/// `may_reach` in any lanes (a triangle's ball against several rays).
+#[inline(always)]
+pub fn may_reach_of<R: Real>(origin: V3<R>, direction: V3<R>, center: V3<R>, radius: R, t_max: R) -> R::Mask {
+    let f = origin - center;
+    let b = f.dot(direction);
+    let closest = f - direction * b;
+    let reach = radius + R::splat(gamma(16)) * (f.abs().element_sum() + radius);
     // Beside the ray, wholly behind its origin, or wholly beyond t_max
-    closest.length_squared() <= reach * reach && b <= reach && -b - reach < t_max
+    closest.length_squared().le(reach * reach).and(b.le(reach)).and((-b - reach).lt(t_max))
 }
 
 #[inline]

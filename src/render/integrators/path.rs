@@ -18,16 +18,18 @@ use crate::scene::Rgb;
 /// Bounces before Russian roulette may end a path.
 pub(crate) const ROULETTE_DEPTH: u32 = 3;
 
-/// Path tracing: eight paths at a time where the world is made of spheres
-/// (`PathLanes`, the same samples bit for bit), one at a time elsewhere.
+/// Path tracing: eight paths at a time where the lanes can trace the world
+/// (`PathLanes`: spheres, planes, triangles, Lambert, mirror and glass; the
+/// same samples bit for bit), one at a time elsewhere.
 pub struct PathTracer {
     max_depth: u32,
-    lanes: Option<PathLanes>,
+    /// Boxed: it holds the scene's shapes and lights, the tracer is moved about.
+    lanes: Option<Box<PathLanes>>,
 }
 
 impl PathTracer {
     pub fn new(world: &World, max_depth: u32) -> Self {
-        Self { max_depth, lanes: PathLanes::new(world) }
+        Self { max_depth, lanes: PathLanes::new(world).map(Box::new) }
     }
 
     #[inline]

@@ -313,12 +313,18 @@ fn sample_area(emitter: &Emitter, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32, 
         }
         Emitter::Triangle { shape: ref triangle, .. } => {
             let (b0, b1) = uniform_triangle(u);
-            let [a, b, c] = triangle.vertices;
-            let point = a * b0 + b * b1 + c * (1.0 - b0 - b1);
+            let point = triangle_point_of(triangle.vertices.map(V3::from), b0, b1).into();
             let pdf = solid_angle_pdf(p, point, triangle.normal, triangle.area());
             (pdf > 0.0).then_some((point, triangle.normal, emitter.error(), pdf))
         }
     }
+}
+
+/// The point of barycentrics (b0, b1, 1 − b0 − b1) on a triangle, for one
+/// point or several.
+#[inline(always)]
+pub fn triangle_point_of<R: Real>([a, b, c]: [V3<R>; 3], b0: R, b1: R) -> V3<R> {
+    a * b0 + b * b1 + c * (R::splat(1.0) - b0 - b1)
 }
 
 /// A uniform-area pdf 1/area turned into solid angle at `p`: d²/(cos θ·A),

@@ -159,8 +159,14 @@ pub fn power_cosine_pdf(cos_theta: f32, exponent: f32) -> f32 {
 /// Uniform barycentrics (b0, b1) on a triangle (b2 = 1 − b0 − b1).
 #[inline]
 pub fn uniform_triangle(u: Vec2) -> (f32, f32) {
-    let su = u.x.sqrt();
-    (1.0 - su, u.y * su)
+    uniform_triangle_of(u.x, u.y)
+}
+
+/// `uniform_triangle` for one sample or several.
+#[inline(always)]
+pub fn uniform_triangle_of<R: Real>(u0: R, u1: R) -> (R, R) {
+    let su = u0.sqrt();
+    (R::splat(1.0) - su, u1 * su)
 }
 
 /// Veach's power heuristic with β = 2; an infinite `pdf_f` (a delta

@@ -1,13 +1,17 @@
-//! Path tracing eight paths at a time, for scenes made of spheres (smallpt's
-//! kind): each sphere is tested against eight rays in one SIMD pass, and the
-//! shading runs in the same lanes. A lane whose path ends takes the next
-//! sample, so lanes stay busy however long the paths are.
+//! Path tracing eight paths at a time: each sphere and plane is tested
+//! against eight rays in one SIMD pass, triangles lane by lane (behind their
+//! bounding balls), and the shading runs in the same lanes. A lane whose
+//! path ends takes the next sample, so lanes stay busy however long the
+//! paths are.
 //!
 //! It is `path::radiance` lane by lane, not an approximation of it: the
 //! same operations in the same order on the same random streams, so the
 //! image is bit for bit the scalar one (`tests/path_lanes.rs` checks it).
 //! Rare cases (a BSDF-sampled ray reaching a light, lights other than a
-//! sphere's cap) call the scalar code for that lane.
+//! sphere's cap or a triangle) and the watertight triangle test call the
+//! scalar code for that lane. Scenes with
+//! other materials than Lambert, mirror, glass and emitters, or with the
+//! background as a light, are traced by the scalar code.
 
 use std::f32::consts::FRAC_1_PI;
 
@@ -16,17 +20,18 @@ use glam::Vec3;
 mod lights;
 mod samples;
 
-use lights::{CapLight, LightLanes};
+use lights::{CapLight, LaneLight, LaneLights, LightLanes, TriangleLight};
 use samples::{CameraSample, CameraSamples};
 
 use super::Counters;
 use crate::faults::{self, Fault};
 use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
-use crate::geometry::{frame_from_z, gamma, offset_origin, to_world, SurfaceHit};
+use crate::geometry::{frame_from_z, gamma, intersect_triangle, offset_origin, to_world, Ray, SurfaceHit, Triangle};
+use crate::geometry::{may_reach_of, plane_exit_of, plane_point_of, plane_t_of};
 use crate::render::world::bsdf::{reflect_of, refraction_of, Bsdf, Refraction};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
-use crate::render::world::light::LightSource;
+use crate::render::world::light::{Emitter, LightSource};
 use crate::render::world::sampling::{cosine_hemisphere_of, power_heuristic, power_heuristic_of};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::{MaterialModel, Rgb};
@@ -34,7 +39,7 @@ use crate::scene::{MaterialModel, Rgb};
 /// Bounces before Russian roulette may end a path (as in `path`).
 const ROULETTE_DEPTH: u32 = crate::render::integrators::path::ROULETTE_DEPTH;
 
-/// The `Bsdf` each sphere's lanes run, as a float to compare eight at a
+/// The `Bsdf` each shape's lanes run, as a float to compare eight at a
 /// time (the lanes run these four; a scene with another model is traced by
 /// the scalar code).
 const LAMBERT: f32 = 0.0;
@@ -42,7 +47,18 @@ const MIRROR: f32 = 1.0;
 const GLASS: f32 = 2.0;
 const EMITTER: f32 = 3.0;
 
-/// One sphere with what shading needs of its material.
+/// What shading needs of a shape's material.
+#[derive(Clone, Copy, Debug)]
+struct Surface {
+    object: u32,
+    /// `LAMBERT`, `MIRROR`, `GLASS` or `EMITTER`.
+    kind: f32,
+    /// Albedo, tint or radiance.
+    color: Rgb,
+    ior: f32,
+}
+
+/// One sphere, as the hit loop meets it.
 #[derive(Clone, Copy, Debug)]
 struct SphereInfo {
     center: Vec3,
@@ -50,17 +66,21 @@ struct SphereInfo {
     radius2: f32,
     /// Bound on the error of points computed on it (as `sphere_hit` gives).
     error: f32,
-    object: u32,
-    /// `LAMBERT`, `MIRROR`, `GLASS` or `EMITTER`.
-    kind: f32,
     /// A wall (`occluders::Walls`), about its point nearest the camera:
     /// paths inside every wall meet it only on their way out (`wall_exit`),
     /// with this `wall_slack`.
     wall: Option<AnchoredSphere>,
     wall_slack: f32,
-    /// Albedo, tint or radiance.
-    color: Rgb,
-    ior: f32,
+}
+
+/// One plane, as the hit loop and shadow rays meet it.
+#[derive(Clone, Copy, Debug)]
+struct PlaneInfo {
+    normal: Vec3,
+    offset: f32,
+    /// A wall (`occluders::WallPlane`): its inside `inward · x > offset`,
+    /// which paths inside every wall leave only through it.
+    wall: Option<(Vec3, f32)>,
 }
 
 /// A sphere as shadow rays test it.
@@ -77,55 +97,84 @@ struct Occluder {
 #[derive(Clone, Debug)]
 pub struct PathLanes {
     spheres: Vec<SphereInfo>,
+    planes: Vec<PlaneInfo>,
+    triangles: Vec<Triangle>,
+    /// Each triangle's light plane (`World::light_plane`): a shadow ray
+    /// toward a light on a triangle skips the triangles of its plane.
+    triangle_planes: Vec<u32>,
+    /// Spheres, then planes, then triangles: what shading needs of each.
+    surfaces: Vec<Surface>,
     /// Shadow rays test these always, and the walls only for paths not
     /// inside every wall (see `occluders::Walls`).
     others: Vec<Occluder>,
     walls: Vec<Occluder>,
-    lights: Vec<Option<CapLight>>,
+    lights: LaneLights,
     /// The sphere each light lies on, if any.
     light_spheres: Vec<Option<u32>>,
+    /// The light plane of the triangle each light lies on, if any.
+    light_planes: Vec<Option<u32>>,
     background: Rgb,
 }
 
 impl PathLanes {
-    /// For worlds of spheres only, with Lambert, mirror, glass and emissive
-    /// materials; None for anything else (the scalar tracer renders it).
+    /// For worlds of spheres, planes and triangles with Lambert, mirror,
+    /// glass and emissive materials; None for anything else (the scalar
+    /// tracer renders it).
     pub fn new(world: &World) -> Option<Self> {
-        if world.spheres.radius.is_empty() || !world.planes.is_empty() || !world.triangles.is_empty() {
-            return None;
-        }
         // The background as a light is sampled one path at a time
         if world.lights.iter().any(|l| matches!(l, LightSource::Background { .. })) {
             return None;
         }
+        let surface = |object: u32| {
+            let material = &world.materials[world.objects[object as usize].material as usize];
+            let (kind, color, ior) = match (Bsdf::new(material), material) {
+                (Bsdf::Lambert { albedo }, _) => (LAMBERT, albedo, 1.0),
+                (Bsdf::Mirror { tint }, _) => (MIRROR, tint, 1.0),
+                (Bsdf::Glass { ior, tint }, _) => (GLASS, tint, ior),
+                (Bsdf::Black, MaterialModel::Emissive { radiance }) => (EMITTER, *radiance, 1.0),
+                _ => return None,
+            };
+            Some(Surface { object, kind, color, ior })
+        };
         let s = &world.spheres;
+        let objects = s.object.iter().copied();
+        let objects = objects.chain(world.planes.iter().map(|p| p.object));
+        let surfaces = objects.chain(world.triangles.iter().map(|(_, object)| *object)).map(surface);
+        let surfaces = surfaces.collect::<Option<Vec<_>>>()?;
+        if surfaces.is_empty() {
+            return None;
+        }
         let wall = |i: usize| world.walls.wall_spheres.iter().find(|(j, _)| *j as usize == i).map(|(_, w)| *w);
-        let spheres = (0..s.radius.len())
+        let spheres: Vec<SphereInfo> = (0..s.radius.len())
             .map(|i| {
-                let object = s.object[i];
                 let (center, radius) = (s.center(i), s.radius[i]);
-                let material = &world.materials[world.objects[object as usize].material as usize];
-                let (kind, color, ior) = match (Bsdf::new(material), material) {
-                    (Bsdf::Lambert { albedo }, _) => (LAMBERT, albedo, 1.0),
-                    (Bsdf::Mirror { tint }, _) => (MIRROR, tint, 1.0),
-                    (Bsdf::Glass { ior, tint }, _) => (GLASS, tint, ior),
-                    (Bsdf::Black, MaterialModel::Emissive { radiance }) => (EMITTER, *radiance, 1.0),
-                    _ => return None,
-                };
-                Some(SphereInfo {
+                SphereInfo {
                     center,
                     radius,
                     radius2: radius * radius,
                     error: gamma(6) * (center.abs().max_element() + radius),
-                    object,
-                    kind,
                     wall: wall(i),
                     wall_slack: wall(i).map_or(0.0, |w| wall_slack(&w)),
-                    color,
-                    ior,
-                })
+                }
             })
-            .collect::<Option<Vec<_>>>()?;
+            .collect();
+        let planes = (world.planes.iter())
+            .map(|plane| PlaneInfo {
+                normal: plane.normal,
+                offset: plane.offset,
+                wall: (world.walls.wall_planes.iter())
+                    .find(|wall| wall.plane.object == plane.object)
+                    .map(|wall| (wall.inward, wall.offset)),
+            })
+            .collect();
+        let light_planes = (world.lights.iter())
+            .map(|light| match *light {
+                LightSource::Area { emitter: Emitter::Triangle { triangle, .. }, .. } => {
+                    Some(world.light_plane[triangle as usize])
+                }
+                _ => None,
+            })
+            .collect();
         // The sphere each light lies on, and the cap the lanes sample of it
         let light_spheres: Vec<Option<u32>> = (world.lights.iter())
             .map(|light| match *light {
@@ -137,19 +186,32 @@ impl PathLanes {
             })
             .collect();
         let lights = (world.lights.iter().zip(&light_spheres))
-            .map(|(light, sphere)| {
-                let (&LightSource::Area { radiance, .. }, &Some(i)) = (light, sphere) else { return None };
-                let cap = world.emitting_cap(i as usize);
-                let info = &spheres[i as usize];
-                (!cap.is_whole()).then(|| CapLight {
-                    center: info.center,
-                    radius: info.radius,
-                    error: info.error,
-                    frame: [cap.frame.x, cap.frame.y, cap.frame.z],
-                    one_minus_cos: cap.one_minus_cos,
-                    area: cap.area(info.radius),
-                    radiance,
-                })
+            .map(|(light, sphere)| match (light, sphere) {
+                (&LightSource::Area { radiance, .. }, &Some(i)) => {
+                    let cap = world.emitting_cap(i as usize);
+                    let info = &spheres[i as usize];
+                    (!cap.is_whole()).then(|| {
+                        LaneLight::Cap(CapLight {
+                            center: info.center,
+                            radius: info.radius,
+                            error: info.error,
+                            frame: [cap.frame.x, cap.frame.y, cap.frame.z],
+                            one_minus_cos: cap.one_minus_cos,
+                            area: cap.area(info.radius),
+                            radiance,
+                        })
+                    })
+                }
+                (LightSource::Area { radiance, emitter: emitter @ Emitter::Triangle { shape, .. }, .. }, _) => {
+                    Some(LaneLight::Triangle(TriangleLight {
+                        vertices: shape.vertices,
+                        normal: shape.normal,
+                        area: shape.area(),
+                        error: emitter.error(),
+                        radiance: *radiance,
+                    }))
+                }
+                _ => None,
             })
             .collect();
         let occluder = |i: usize| Occluder {
@@ -162,8 +224,13 @@ impl PathLanes {
             others: others.into_iter().map(occluder).collect(),
             walls: walls.into_iter().map(occluder).collect(),
             spheres,
-            lights,
+            planes,
+            triangles: world.triangles.iter().map(|(triangle, _)| *triangle).collect(),
+            triangle_planes: world.light_plane.clone(),
+            surfaces,
+            lights: LaneLights::new(lights),
             light_spheres,
+            light_planes,
             background: world.background,
         })
     }
@@ -287,6 +354,48 @@ impl PathLanes {
             index = closer.select(k, index);
             k = k + 1.0;
         }
+        // Planes: in index order for paths not held (`World::intersect`);
+        // for held ones the planes that are not walls, then the walls'
+        // ways out (`World::intersect_held`)
+        let first_plane = self.spheres.len() as f32;
+        let mut k = F8::splat(first_plane);
+        for plane in &self.planes {
+            if plane.wall.is_none() || !every_held {
+                let (normal, offset) = (V8::splat(plane.normal), F8::splat(plane.offset));
+                let (t, hits) = plane_t_of(origin, direction, normal, offset, t_hit);
+                let closer = if plane.wall.is_some() { hits.and_not(held) } else { hits };
+                t_hit = closer.select(t, t_hit);
+                index = closer.select(k, index);
+            }
+            k = k + 1.0;
+        }
+        if held.any() {
+            let mut k = F8::splat(first_plane);
+            for plane in &self.planes {
+                if let Some((inward, offset)) = plane.wall {
+                    let (t, exits) = plane_exit_of(origin, direction, V8::splat(inward), F8::splat(offset), t_hit);
+                    let closer = exits.and(held);
+                    t_hit = closer.select(t, t_hit);
+                    index = closer.select(k, index);
+                }
+                k = k + 1.0;
+            }
+        }
+        // Triangles last, as both do: lane by lane, for the lanes whose
+        // ray may reach the triangle's ball (tested in the lanes)
+        let first_triangle = first_plane + self.planes.len() as f32;
+        let mut triangle_hits = [None; LANES];
+        for (j, triangle) in self.triangles.iter().enumerate() {
+            let near = self.may_reach(j, active, origin, direction, t_hit);
+            for lane in (0..LANES).filter(|&i| near.test(i)) {
+                let ray = Ray::new(origin.lane(lane), direction.lane(lane));
+                if let Some(hit) = intersect_triangle(&ray, triangle, t_hit.lane(lane)) {
+                    t_hit.set_lane(lane, hit.t);
+                    index.set_lane(lane, first_triangle + j as f32);
+                    triangle_hits[lane] = Some(hit);
+                }
+            }
+        }
         let found = active.and(t_hit.lt(F8::splat(f32::INFINITY)));
         let missed = active.and_not(found);
         if missed.any() {
@@ -297,41 +406,36 @@ impl PathLanes {
         if !alive.any() {
             return missed;
         }
-        let sphere: [&SphereInfo; LANES] = {
-            let index = index.truncate();
-            lanes::each(|i| &self.spheres[index[i] as usize])
-        };
-        let code = F8::from_fn(|i| sphere[i].kind);
+        let shape = index.truncate();
+        let surface: [&Surface; LANES] = lanes::each(|i| &self.surfaces[shape[i] as usize]);
+        let code = F8::from_fn(|i| surface[i].kind);
         let kind = |k: f32| code.eq(F8::splat(k)).and(alive);
         let (lambert, mirror, glass, emissive) = (kind(LAMBERT), kind(MIRROR), kind(GLASS), kind(EMITTER));
-        let color = V8::from_fn(|i| sphere[i].color);
+        let color = V8::from_fn(|i| surface[i].color);
+        let on_sphere = alive.and(index.lt(F8::splat(first_plane)));
+        let on_plane = alive.and_not(on_sphere).and(index.lt(F8::splat(first_triangle)));
 
-        // The hit, rebuilt from the closest approach as `sphere_hit` does
-        let center = V8::from_fn(|i| sphere[i].center);
-        let radius = F8::from_fn(|i| sphere[i].radius);
-        // A wall holding the path is left where `wall_exit` found it
-        let leaving = held.and(M8::from_fn(|i| sphere[i].wall.is_some())).and(alive);
         let (mut point, mut normal, mut error) = (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
-        if alive.and_not(leaving).any() {
-            let f = origin - center;
-            // Which root `roots` took (solved again: cheaper than tracking
-            // it through the search)
-            let (near_root, _, discriminant) = roots(f, direction, radius * radius);
-            let near = near_root.gt(F8::splat(0.0));
-            let closest = f - direction * f.dot(direction);
-            let half_chord = discriminant.max(F8::splat(0.0)).sqrt();
-            let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
-            let length = from_center.length();
-            normal = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
-            point = center + normal * radius;
-            error = F8::from_fn(|i| sphere[i].error);
+        if on_sphere.any() {
+            self.sphere_hits(on_sphere, held, &shape, origin, direction, t_hit, &mut point, &mut normal, &mut error);
         }
-        if leaving.any() {
-            let slack = F8::from_fn(|i| sphere[i].wall_slack);
-            let (p, n, e) = wall_exit_hit(origin, direction, t_hit, center, slack);
-            point = leaving.select_v(p, point);
-            normal = leaving.select_v(n, normal);
-            error = leaving.select(e, error);
+        if on_plane.any() {
+            let last = self.planes.len() - 1;
+            let plane: [&PlaneInfo; LANES] =
+                lanes::each(|i| &self.planes[(shape[i] as usize).saturating_sub(self.spheres.len()).min(last)]);
+            let plane_normal = V8::from_fn(|i| plane[i].normal);
+            let offset = F8::from_fn(|i| plane[i].offset);
+            let (p, e) = plane_point_of(origin, direction, plane_normal, offset, t_hit);
+            point = on_plane.select_v(p, point);
+            normal = on_plane.select_v(plane_normal, normal);
+            error = on_plane.select(e, error);
+        }
+        for (lane, hit) in triangle_hits.iter().enumerate() {
+            if let Some(hit) = hit.filter(|_| alive.test(lane)) {
+                point.set_lane(lane, hit.point);
+                normal.set_lane(lane, hit.normal);
+                error.set_lane(lane, hit.error);
+            }
         }
         let wo = -direction;
         let hit = |i: usize| SurfaceHit {
@@ -346,7 +450,7 @@ impl PathLanes {
         let pick_pdf = 1.0 / light_count.max(1) as f32;
         let glowing = emissive.and(normal.dot(wo).gt(F8::splat(0.0))).and(color.nonzero());
         for lane in (0..LANES).filter(|&i| glowing.test(i)) {
-            let object = sphere[lane].object;
+            let object = surface[lane].object;
             let weight = match world.objects[object as usize].light {
                 Some(light) if !st.after_delta.test(lane) => power_heuristic(
                     st.last_pdf.lane(lane),
@@ -354,7 +458,7 @@ impl PathLanes {
                 ),
                 _ => 1.0,
             };
-            let sum = st.radiance.lane(lane) + st.throughput.lane(lane) * sphere[lane].color * weight;
+            let sum = st.radiance.lane(lane) + st.throughput.lane(lane) * surface[lane].color * weight;
             st.radiance.set_lane(lane, sum);
         }
 
@@ -406,7 +510,7 @@ impl PathLanes {
             scattered = scattered.or(ok);
         }
         if glass.any() {
-            let ior = F8::from_fn(|i| sphere[i].ior);
+            let ior = F8::from_fn(|i| surface[i].ior);
             let entering = wo.dot(normal).gt(zero);
             let eta_i = entering.select(F8::splat(1.0), ior);
             let eta_t = entering.select(ior, F8::splat(1.0));
@@ -450,6 +554,63 @@ impl PathLanes {
         done.or(killed).or(go.and(st.depth.ge(max_depth)))
     }
 
+    /// The hits of lanes `on_sphere` (`shape` their sphere's index), rebuilt
+    /// from the closest approach as `sphere_hit` does; a wall holding the
+    /// path is left where `wall_exit` found it.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn sphere_hits(
+        &self,
+        on_sphere: M8,
+        held: M8,
+        shape: &[i32; LANES],
+        origin: V8,
+        direction: V8,
+        t_hit: F8,
+        point: &mut V8,
+        normal: &mut V8,
+        error: &mut F8,
+    ) {
+        let last = self.spheres.len() - 1;
+        let sphere: [&SphereInfo; LANES] = lanes::each(|i| &self.spheres[(shape[i] as usize).min(last)]);
+        let center = V8::from_fn(|i| sphere[i].center);
+        let radius = F8::from_fn(|i| sphere[i].radius);
+        let leaving = held.and(M8::from_fn(|i| sphere[i].wall.is_some())).and(on_sphere);
+        if on_sphere.and_not(leaving).any() {
+            let f = origin - center;
+            // Which root `roots` took (solved again: cheaper than tracking
+            // it through the search)
+            let (near_root, _, discriminant) = roots(f, direction, radius * radius);
+            let near = near_root.gt(F8::splat(0.0));
+            let closest = f - direction * f.dot(direction);
+            let half_chord = discriminant.max(F8::splat(0.0)).sqrt();
+            let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
+            let length = from_center.length();
+            let n = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
+            *point = on_sphere.select_v(center + n * radius, *point);
+            *normal = on_sphere.select_v(n, *normal);
+            *error = on_sphere.select(F8::from_fn(|i| sphere[i].error), *error);
+        }
+        if leaving.any() {
+            let slack = F8::from_fn(|i| sphere[i].wall_slack);
+            let (p, n, e) = wall_exit_hit(origin, direction, t_hit, center, slack);
+            *point = leaving.select_v(p, *point);
+            *normal = leaving.select_v(n, *normal);
+            *error = leaving.select(e, *error);
+        }
+    }
+
+    /// Lanes of `mask` whose ray may reach triangle `j` before `t_max`
+    /// (`intersect_triangle`'s first test, which it repeats).
+    #[inline(always)]
+    fn may_reach(&self, j: usize, mask: M8, origin: V8, direction: V8, t_max: F8) -> M8 {
+        let (center, radius) = self.triangles[j].bound();
+        if !mask.any() || self.triangles[j].is_degenerate() {
+            return M8::NONE;
+        }
+        mask.and(may_reach_of(origin, direction, V8::splat(center), F8::splat(radius), t_max))
+    }
+
     /// Lanes whose segment (origin, unit direction, t_max) meets `sphere`.
     #[inline(always)]
     fn hits(sphere: &Occluder, origin: V8, direction: V8, t_max: F8) -> M8 {
@@ -476,6 +637,26 @@ impl PathLanes {
         if outside.any() {
             for sphere in &self.walls {
                 blocked = blocked.or(outside.and(Self::hits(sphere, origin, direction, t_max)));
+            }
+        }
+        for plane in &self.planes {
+            if plane.wall.is_none() || outside.any() {
+                let (normal, offset) = (V8::splat(plane.normal), F8::splat(plane.offset));
+                let hits = plane_t_of(origin, direction, normal, offset, t_max).1;
+                blocked = blocked.or(if plane.wall.is_some() { outside.and(hits) } else { hits });
+            }
+        }
+        // Triangles lane by lane where the ray may reach them, but those in
+        // the plane of the light's own triangle (`Occluders::blocks`)
+        for (j, (triangle, plane)) in self.triangles.iter().zip(&self.triangle_planes).enumerate() {
+            let near = self.may_reach(j, mask.and_not(blocked), origin, direction, t_max);
+            for lane in (0..LANES).filter(|&i| near.test(i)) {
+                let ray = Ray::new(origin.lane(lane), direction.lane(lane));
+                if self.light_planes[pick[lane]] != Some(*plane)
+                    && intersect_triangle(&ray, triangle, t_max.lane(lane)).is_some()
+                {
+                    blocked.set(lane, true);
+                }
             }
         }
         mask.and(blocked)
