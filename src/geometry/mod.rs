@@ -16,7 +16,7 @@ pub use ray::{gamma, offset_origin, offset_ray_origin, spawn_offset_scale, Ray};
 pub use sphere::intersect_sphere;
 pub(crate) use sphere::sphere_hit;
 pub use sphere::sphere_t;
-pub(crate) use triangle::may_reach_of;
+pub(crate) use triangle::{edges_of, may_reach_of, shear_of, triangle_hit_of, watertight_hit_of};
 pub use triangle::{intersect_triangle, Triangle};
 
 use glam::Vec3;

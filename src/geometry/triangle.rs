@@ -88,74 +88,112 @@ pub fn may_reach_of<R: Real>(origin: V3<R>, direction: V3<R>, center: V3<R>, rad
 
 #[inline]
 fn watertight(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<SurfaceHit> {
-    let [p0, p1, p2] = triangle.vertices;
-    // Translate vertices to the ray origin, permute so z is the largest axis of d
-    let d = ray.direction;
-    let kz = d.abs().max_position();
-    let kx = if kz == 2 { 0 } else { kz + 1 };
-    let ky = if kx == 2 { 0 } else { kx + 1 };
-    let permute = |v: Vec3| Vec3::new(v[kx], v[ky], v[kz]);
-    let d = permute(d);
-    let mut p0t = permute(p0 - ray.origin);
-    let mut p1t = permute(p1 - ray.origin);
-    let mut p2t = permute(p2 - ray.origin);
-    // Shear so the ray points along +z
-    let sz = 1.0 / d.z;
+    let vertices = triangle.vertices.map(V3::from);
+    let (sheared, sz) = shear_of(ray.origin.into(), ray.direction.into(), vertices);
+    let mut edges = edges_of(sheared);
+    // On an edge, redone in f64 (where the f32 products cancelled to zero)
+    if edges.contains(&0.0) {
+        let [a, b, c] = sheared.map(|p| Vec3::from(p).as_dvec3());
+        let edge = |u: DVec3, v: DVec3| (u.x * v.y - u.y * v.x) as f32;
+        edges = [edge(b, c), edge(c, a), edge(a, b)];
+    }
+    let (t, hit, barycentrics) = watertight_hit_of(sheared, edges, sz, t_max);
+    if !hit {
+        return None;
+    }
+    let (point, error) = triangle_hit_of(vertices, barycentrics);
+    Some(SurfaceHit { t, point: point.into(), normal: triangle.normal, error })
+}
+
+/// The watertight test's first step, for one ray or several: the vertices
+/// translated to the ray's origin, permuted so that z is the largest axis
+/// of its direction and sheared so that it points along +z (z not yet
+/// scaled), and the scale `sz` for z.
+#[inline(always)]
+pub fn shear_of<R: Real>(origin: V3<R>, direction: V3<R>, vertices: [V3<R>; 3]) -> ([V3<R>; 3], R) {
+    // glam's `max_position` of |d| (the first largest), as selects
+    let a = direction.abs();
+    let y_largest = a.y.gt(a.x);
+    let z_largest = a.z.gt(R::select(y_largest, a.y, a.x));
+    // Functions, not closures: a closure is left out of line, without AVX2
+    #[inline(always)]
+    fn permute<R: Real>(v: V3<R>, y_largest: R::Mask, z_largest: R::Mask) -> V3<R> {
+        V3::new(
+            R::select(z_largest, v.x, R::select(y_largest, v.z, v.y)),
+            R::select(z_largest, v.y, R::select(y_largest, v.x, v.z)),
+            R::select(z_largest, v.z, R::select(y_largest, v.y, v.x)),
+        )
+    }
+    #[inline(always)]
+    fn shear<R: Real>(p: V3<R>, sx: R, sy: R) -> V3<R> {
+        V3::new(p.x + sx * p.z, p.y + sy * p.z, p.z)
+    }
+    let d = permute(direction, y_largest, z_largest);
+    let sz = R::splat(1.0) / d.z;
     let sx = -d.x * sz;
     let sy = -d.y * sz;
-    for p in [&mut p0t, &mut p1t, &mut p2t] {
-        p.x += sx * p.z;
-        p.y += sy * p.z;
-    }
-    // Edge functions, redone in f64 when one is exactly zero (the edge case)
-    let mut e0 = p1t.x * p2t.y - p1t.y * p2t.x;
-    let mut e1 = p2t.x * p0t.y - p2t.y * p0t.x;
-    let mut e2 = p0t.x * p1t.y - p0t.y * p1t.x;
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        let (a, b, c) = (p0t.as_dvec3(), p1t.as_dvec3(), p2t.as_dvec3());
-        let edge = |u: DVec3, v: DVec3| (u.x * v.y - u.y * v.x) as f32;
-        e0 = edge(b, c);
-        e1 = edge(c, a);
-        e2 = edge(a, b);
-    }
-    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
-        return None;
-    }
+    let [p0, p1, p2] = vertices;
+    let sheared = [
+        shear(permute(p0 - origin, y_largest, z_largest), sx, sy),
+        shear(permute(p1 - origin, y_largest, z_largest), sx, sy),
+        shear(permute(p2 - origin, y_largest, z_largest), sx, sy),
+    ];
+    (sheared, sz)
+}
+
+/// The edge functions of the sheared vertices; where one is exactly zero
+/// the scalar code redoes them in f64.
+#[inline(always)]
+pub fn edges_of<R: Real>([p0, p1, p2]: [V3<R>; 3]) -> [R; 3] {
+    [p1.x * p2.y - p1.y * p2.x, p2.x * p0.y - p2.y * p0.x, p0.x * p1.y - p0.y * p1.x]
+}
+
+/// The watertight test's verdict from the sheared vertices and their edge
+/// functions: (t, whether the ray hits within (δt, t_max), barycentrics).
+#[inline(always)]
+pub fn watertight_hit_of<R: Real>(sheared: [V3<R>; 3], [e0, e1, e2]: [R; 3], sz: R, t_max: R) -> (R, R::Mask, [R; 3]) {
+    let zero = R::splat(0.0);
+    let [p0, p1, p2] = sheared;
+    // Inside when the edge functions do not differ in sign
+    let negative = e0.lt(zero).or(e1.lt(zero)).or(e2.lt(zero));
+    let positive = e0.gt(zero).or(e1.gt(zero)).or(e2.gt(zero));
     let det = e0 + e1 + e2;
-    if det == 0.0 {
-        return None;
-    }
     // Scaled distance, tested against the range before dividing
-    p0t.z *= sz;
-    p1t.z *= sz;
-    p2t.z *= sz;
-    let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
-        return None;
-    }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
-        return None;
-    }
-    let inv_det = 1.0 / det;
-    let (b0, b1, b2) = (e0 * inv_det, e1 * inv_det, e2 * inv_det);
+    let (z0, z1, z2) = (p0.z * sz, p1.z * sz, p2.z * sz);
+    let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
+    let bound = t_max * det;
+    let behind_or_beyond = (det.lt(zero).and(t_scaled.ge(zero).or(t_scaled.lt(bound))))
+        .or(det.gt(zero).and(t_scaled.le(zero).or(t_scaled.gt(bound))));
+    let inv_det = R::splat(1.0) / det;
+    let barycentrics = [e0 * inv_det, e1 * inv_det, e2 * inv_det];
     let t = t_scaled * inv_det;
     // Conservatively reject t too close to zero to be trusted (pbrt's δt)
-    let max_zt = Vec3::new(p0t.z, p1t.z, p2t.z).abs().max_element();
-    let delta_z = gamma(3) * max_zt;
-    let max_xt = Vec3::new(p0t.x, p1t.x, p2t.x).abs().max_element();
-    let max_yt = Vec3::new(p0t.y, p1t.y, p2t.y).abs().max_element();
-    let delta_x = gamma(5) * (max_xt + max_zt);
-    let delta_y = gamma(5) * (max_yt + max_zt);
-    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    let max_e = Vec3::new(e0, e1, e2).abs().max_element();
-    let delta_t = 3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
-    if t <= delta_t || !t.is_finite() {
-        return None;
-    }
+    let max_zt = V3::new(z0, z1, z2).abs().max_element();
+    let delta_z = max_zt * gamma(3);
+    let max_xt = V3::new(p0.x, p1.x, p2.x).abs().max_element();
+    let max_yt = V3::new(p0.y, p1.y, p2.y).abs().max_element();
+    let delta_x = (max_xt + max_zt) * gamma(5);
+    let delta_y = (max_yt + max_zt) * gamma(5);
+    let delta_e = (max_xt * gamma(2) * max_yt + delta_y * max_xt + delta_x * max_yt) * 2.0;
+    let max_e = V3::new(e0, e1, e2).abs().max_element();
+    let delta_t = (max_e * gamma(3) * max_zt + delta_e * max_zt + delta_z * max_e) * 3.0 * inv_det.abs();
+    let hit = t
+        .is_finite()
+        .and_not(t.le(delta_t))
+        .and_not(negative.and(positive))
+        .and_not(det.eq(zero))
+        .and_not(behind_or_beyond);
+    (t, hit, barycentrics)
+}
+
+/// The point of a hit from its barycentrics, as a weighted sum of the
+/// vertices, and its error bound.
+#[inline(always)]
+pub fn triangle_hit_of<R: Real>([p0, p1, p2]: [V3<R>; 3], [b0, b1, b2]: [R; 3]) -> (V3<R>, R) {
     let weighted = [p0 * b0, p1 * b1, p2 * b2];
     let point = weighted[0] + weighted[1] + weighted[2];
-    let error = gamma(7) * (weighted[0].abs() + weighted[1].abs() + weighted[2].abs()).max_element();
-    Some(SurfaceHit { t, point, normal: triangle.normal, error })
+    let error = (weighted[0].abs() + weighted[1].abs() + weighted[2].abs()).max_element() * gamma(7);
+    (point, error)
 }
 
 #[cfg(test)]

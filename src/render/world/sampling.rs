@@ -135,7 +135,13 @@ pub fn uniform_cone_of<R: Real>(u0: R, u1: R, one_minus_cos_max: R) -> V3<R> {
 
 #[inline]
 pub fn uniform_cone_pdf(one_minus_cos_max: f32) -> f32 {
-    1.0 / (2.0 * PI * one_minus_cos_max)
+    uniform_cone_pdf_of(one_minus_cos_max)
+}
+
+/// `uniform_cone_pdf` for one cone or several.
+#[inline(always)]
+pub fn uniform_cone_pdf_of<R: Real>(one_minus_cos_max: R) -> R {
+    R::splat(1.0) / (R::splat(2.0 * PI) * one_minus_cos_max)
 }
 
 /// Direction about +z with pdf ∝ cosⁿθ: pdf = (n + 1)/(2π) · cosⁿθ.

@@ -1,84 +1,103 @@
-//! Light sampling in eight lanes: sphere caps (smallpt's light) and
-//! triangles computed in the lanes, any other light through the scalar code
-//! lane by lane.
+//! Light sampling in eight lanes: area lights (sphere caps, whole spheres
+//! and triangles) drawn in the lanes, any other light through the scalar
+//! code lane by lane.
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::{ray_to, to_world, SurfaceHit};
+use crate::geometry::sphere::nearest_root;
+use crate::geometry::{frame_from_z, ray_to, to_world, SurfaceHit};
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
-use crate::render::world::light::{solid_angle_pdf_of, triangle_point_of};
-use crate::render::world::sampling::{uniform_cone_of, uniform_triangle_of};
+use crate::render::world::light::{solid_angle_pdf_of, triangle_point_of, Emitter, LightSource};
+use crate::render::world::sampling::{uniform_cone_of, uniform_cone_pdf_of, uniform_triangle_of};
 use crate::render::world::World;
 use crate::scene::Rgb;
 
-/// An area light the lanes sample (`LightSource::sample` of an area light);
-/// other lights the scalar code samples lane by lane.
+/// An area light as the lanes draw it (`sample_area`).
 #[derive(Clone, Copy, Debug)]
-pub(super) enum LaneLight {
-    /// A sphere light's emitting cap, uniform over its area.
+enum LaneLight {
+    /// The emitting cap of a sphere partly hidden (smallpt's light in its
+    /// ceiling), uniform over its area.
     Cap(CapLight),
-    /// A triangle light, uniform over its area.
+    /// A whole sphere, uniform over the cone it subtends.
+    Sphere(SphereLight),
+    /// A triangle, uniform over its area.
     Triangle(TriangleLight),
 }
 
 #[derive(Clone, Copy, Debug)]
-pub(super) struct CapLight {
-    pub(super) center: Vec3,
-    pub(super) radius: f32,
-    pub(super) error: f32,
-    pub(super) frame: [Vec3; 3],
-    pub(super) one_minus_cos: f32,
-    pub(super) area: f32,
-    pub(super) radiance: Rgb,
-}
-
-impl CapLight {
-    /// Where the lanes' lights hold none.
-    const NONE: CapLight = CapLight {
-        center: Vec3::ZERO,
-        radius: 0.0,
-        error: 0.0,
-        frame: [Vec3::X, Vec3::Y, Vec3::Z],
-        one_minus_cos: 0.0,
-        area: 0.0,
-        radiance: Vec3::ZERO,
-    };
+struct CapLight {
+    center: Vec3,
+    radius: f32,
+    error: f32,
+    frame: [Vec3; 3],
+    one_minus_cos: f32,
+    area: f32,
+    radiance: Rgb,
 }
 
 #[derive(Clone, Copy, Debug)]
-pub(super) struct TriangleLight {
-    pub(super) vertices: [Vec3; 3],
-    pub(super) normal: Vec3,
-    pub(super) area: f32,
-    pub(super) error: f32,
-    pub(super) radiance: Rgb,
+struct SphereLight {
+    center: Vec3,
+    radius: f32,
+    error: f32,
+    radiance: Rgb,
 }
 
-impl TriangleLight {
-    /// Where the lanes' lights hold none.
-    const NONE: TriangleLight =
-        TriangleLight { vertices: [Vec3::ZERO; 3], normal: Vec3::Z, area: 0.0, error: 0.0, radiance: Vec3::ZERO };
+#[derive(Clone, Copy, Debug)]
+struct TriangleLight {
+    vertices: [Vec3; 3],
+    normal: Vec3,
+    area: f32,
+    error: f32,
+    radiance: Rgb,
 }
 
-/// Points drawn on the lights of some lanes, before the shadow ray.
-struct Drawn {
-    target: V8,
-    normal: V8,
-    error: F8,
-    area: F8,
-    radiance: V8,
-}
+impl LaneLight {
+    /// The light the lanes draw for `light`, if they draw it.
+    fn new(light: &LightSource) -> Option<Self> {
+        let LightSource::Area { radiance, emitter, .. } = *light else { return None };
+        let error = emitter.error();
+        Some(match emitter {
+            Emitter::Sphere { center, radius, cap, .. } if cap.is_whole() => {
+                LaneLight::Sphere(SphereLight { center, radius, error, radiance })
+            }
+            Emitter::Sphere { center, radius, cap, .. } => LaneLight::Cap(CapLight {
+                center,
+                radius,
+                error,
+                frame: [cap.frame.x, cap.frame.y, cap.frame.z],
+                one_minus_cos: cap.one_minus_cos,
+                area: cap.area(radius),
+                radiance,
+            }),
+            Emitter::Triangle { shape, .. } => LaneLight::Triangle(TriangleLight {
+                vertices: shape.vertices,
+                normal: shape.normal,
+                area: shape.area(),
+                error,
+                radiance,
+            }),
+        })
+    }
 
-impl Drawn {
-    /// `a` in the lanes of `mask`, `b` elsewhere.
-    #[inline(always)]
-    fn select(mask: M8, a: Drawn, b: Drawn) -> Drawn {
-        Drawn {
-            target: V8::select(mask, a.target, b.target),
-            normal: V8::select(mask, a.normal, b.normal),
-            error: mask.select(a.error, b.error),
-            area: mask.select(a.area, b.area),
-            radiance: V8::select(mask, a.radiance, b.radiance),
+    fn cap(&self) -> Option<&CapLight> {
+        match self {
+            LaneLight::Cap(cap) => Some(cap),
+            _ => None,
+        }
+    }
+
+    fn sphere(&self) -> Option<&SphereLight> {
+        match self {
+            LaneLight::Sphere(sphere) => Some(sphere),
+            _ => None,
+        }
+    }
+
+    fn triangle(&self) -> Option<&TriangleLight> {
+        match self {
+            LaneLight::Triangle(triangle) => Some(triangle),
+            _ => None,
         }
     }
 }
@@ -89,71 +108,78 @@ impl Drawn {
 pub(super) struct LaneLights {
     /// Each light of the world, `None` for those sampled lane by lane.
     lights: Vec<Option<LaneLight>>,
-    /// The first cap and the first triangle, and whether it is the only one
-    /// of its kind.
-    first_cap: Option<(CapLight, bool)>,
-    first_triangle: Option<(TriangleLight, bool)>,
-    all_in_lanes: bool,
+    /// Whether every light is of one kind the lanes draw (then every lane
+    /// draws that kind).
+    one_kind: bool,
+    /// Of each kind, the index of the first light and whether it is the
+    /// only one (then it is splat rather than gathered lane by lane).
+    first: [Option<(usize, bool)>; 3],
 }
 
 impl LaneLights {
-    pub(super) fn new(lights: Vec<Option<LaneLight>>) -> Self {
-        fn first<T: Copy>(mut of_kind: impl Iterator<Item = T>) -> Option<(T, bool)> {
+    pub(super) fn new(world: &World) -> Self {
+        let lights: Vec<_> = world.lights.iter().map(LaneLight::new).collect();
+        let first = |kind: fn(&LaneLight) -> bool| {
+            let mut of_kind = (0..lights.len()).filter(|&i| lights[i].as_ref().is_some_and(kind));
             let first = of_kind.next()?;
             Some((first, of_kind.next().is_none()))
-        }
+        };
+        let first = [
+            first(|light| light.cap().is_some()),
+            first(|light| light.sphere().is_some()),
+            first(|light| light.triangle().is_some()),
+        ];
         LaneLights {
-            first_cap: first(lights.iter().flatten().filter_map(LaneLight::cap)),
-            first_triangle: first(lights.iter().flatten().filter_map(LaneLight::triangle)),
-            all_in_lanes: lights.iter().all(Option::is_some),
+            one_kind: lights.iter().all(Option::is_some) && first.iter().flatten().count() == 1,
+            first,
             lights,
         }
     }
-}
 
-impl LaneLight {
-    fn cap(&self) -> Option<CapLight> {
-        match *self {
-            LaneLight::Cap(cap) => Some(cap),
-            LaneLight::Triangle(_) => None,
-        }
-    }
-
-    fn triangle(&self) -> Option<TriangleLight> {
-        match *self {
-            LaneLight::Triangle(triangle) => Some(triangle),
-            LaneLight::Cap(_) => None,
-        }
-    }
-}
-
-/// Each lane's light of one kind: the one light of that kind, splat, or
-/// each lane's own, lanes of another kind computing on the first light of
-/// this kind, unused.
-enum PerLane<T> {
-    One(T),
-    Each([T; LANES]),
-}
-
-impl<T: Copy> PerLane<T> {
+    /// The lanes of `mask` whose light is of one kind (`kind`, the `which`th
+    /// kind), and their lights; `None` if there are no such lanes.
     #[inline(always)]
-    fn of(
-        lights: &LaneLights,
+    fn of_kind<'a, T>(
+        &'a self,
         pick: &[usize; LANES],
-        (first, only): (T, bool),
-        kind: impl Fn(&LaneLight) -> Option<T>,
-    ) -> Self {
-        match only {
-            true => PerLane::One(first),
-            false => PerLane::Each(lanes::each(|i| lights.lights[pick[i]].as_ref().and_then(&kind).unwrap_or(first))),
+        mask: M8,
+        which: usize,
+        kind: fn(&LaneLight) -> Option<&T>,
+    ) -> Option<(M8, PerLane<'a, T>)> {
+        let (first, single) = self.first[which]?;
+        let first = self.lights[first].as_ref().and_then(kind)?;
+        let lane_kind = |i: usize| self.lights[pick[i]].as_ref().and_then(kind);
+        let lanes = match self.one_kind {
+            true => mask,
+            false => M8::from_fn(|i| lane_kind(i).is_some()).and(mask),
+        };
+        if !lanes.any() {
+            return None;
         }
+        Some((
+            lanes,
+            match single {
+                true => PerLane::One(first),
+                // Lanes of another kind compute on the first light of this one, unused
+                false => PerLane::Each(lanes::each(|i| lane_kind(i).unwrap_or(first))),
+            },
+        ))
     }
+}
 
+/// Each lane's light of one kind: the only light of its kind, splat, or
+/// each lane's own.
+enum PerLane<'a, T> {
+    One(&'a T),
+    Each([&'a T; LANES]),
+}
+
+impl<T> PerLane<'_, T> {
     #[inline(always)]
     fn f8(&self, field: impl Fn(&T) -> f32) -> F8 {
         match self {
             PerLane::One(light) => F8::splat(field(light)),
-            PerLane::Each(lights) => F8::from_fn(|i| field(&lights[i])),
+            PerLane::Each(lights) => F8::from_fn(|i| field(lights[i])),
         }
     }
 
@@ -161,37 +187,97 @@ impl<T: Copy> PerLane<T> {
     fn v8(&self, field: impl Fn(&T) -> Vec3) -> V8 {
         match self {
             PerLane::One(light) => V8::splat(field(light)),
-            PerLane::Each(lights) => V8::from_fn(|i| field(&lights[i])),
+            PerLane::Each(lights) => V8::from_fn(|i| field(lights[i])),
+        }
+    }
+}
+
+/// Points drawn on the lights of some lanes, before the shadow ray: the
+/// point, the light's normal there, its error bound, the solid-angle pdf at
+/// the shading point and the radiance.
+struct Drawn {
+    target: V8,
+    normal: V8,
+    error: F8,
+    pdf: F8,
+    radiance: V8,
+}
+
+impl Drawn {
+    /// `self` in the lanes of `mask`, `before` elsewhere (if any).
+    #[inline(always)]
+    fn over(self, mask: M8, before: Option<Drawn>) -> Drawn {
+        let Some(b) = before else { return self };
+        Drawn {
+            target: V8::select(mask, self.target, b.target),
+            normal: V8::select(mask, self.normal, b.normal),
+            error: mask.select(self.error, b.error),
+            pdf: mask.select(self.pdf, b.pdf),
+            radiance: V8::select(mask, self.radiance, b.radiance),
         }
     }
 }
 
 /// Uniform over each lane's cap (`sample_area`).
 #[inline(always)]
-fn draw_on_caps(caps: &PerLane<CapLight>, u: (F8, F8)) -> Drawn {
+fn draw_on_caps(caps: &PerLane<CapLight>, p: V8, u: (F8, F8)) -> Drawn {
     // Written out: `array::from_fn` is left out of line, without AVX2
     let frame = [caps.v8(|cap| cap.frame[0]), caps.v8(|cap| cap.frame[1]), caps.v8(|cap| cap.frame[2])];
     let normal = to_world(frame, uniform_cone_of(u.0, u.1, caps.f8(|cap| cap.one_minus_cos)));
+    let target = caps.v8(|cap| cap.center) + normal * caps.f8(|cap| cap.radius);
     Drawn {
-        target: caps.v8(|cap| cap.center) + normal * caps.f8(|cap| cap.radius),
+        target,
         normal,
         error: caps.f8(|cap| cap.error),
-        area: caps.f8(|cap| cap.area),
+        pdf: solid_angle_pdf_of(p, target, normal, caps.f8(|cap| cap.area)),
         radiance: caps.v8(|cap| cap.radiance),
+    }
+}
+
+/// Uniform over the cone each lane's sphere subtends, the point where the
+/// direction meets the sphere (`sample_area`); pdf 0 from inside it.
+#[inline(always)]
+fn draw_on_spheres(spheres: &PerLane<SphereLight>, p: V8, u: (F8, F8)) -> Drawn {
+    let (center, radius) = (spheres.v8(|sphere| sphere.center), spheres.f8(|sphere| sphere.radius));
+    let one = F8::splat(1.0);
+    let to_center = center - p;
+    let distance2 = to_center.length_squared();
+    let sin2_max = radius * radius / distance2;
+    let one_minus_cos = sin2_max / (one + (one - sin2_max).sqrt());
+    let axis = to_center / distance2.sqrt();
+    let direction = to_world(frame_from_z(axis), uniform_cone_of(u.0, u.1, one_minus_cos));
+    // `intersect_sphere` (`sphere_hit`'s point from the closest approach)
+    let f = p - center;
+    let (_, hit, near) = nearest_root(f, direction, radius * radius, F8::splat(f32::INFINITY));
+    let closest = f - direction * f.dot(direction);
+    let half_chord = (radius * radius - closest.length_squared()).max(F8::splat(0.0)).sqrt();
+    let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
+    let length = from_center.length();
+    let hit_normal = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
+    // The cone's edge rays may miss by rounding: the closest approach
+    let miss_normal = (p + direction * to_center.dot(direction) - center).normalize();
+    let normal = hit.select_v(hit_normal, miss_normal);
+    Drawn {
+        target: center + normal * radius,
+        normal,
+        error: spheres.f8(|sphere| sphere.error),
+        pdf: sin2_max.lt(one).select(uniform_cone_pdf_of(one_minus_cos), F8::splat(0.0)),
+        radiance: spheres.v8(|sphere| sphere.radiance),
     }
 }
 
 /// Uniform over each lane's triangle (`sample_area`).
 #[inline(always)]
-fn draw_on_triangles(triangles: &PerLane<TriangleLight>, u: (F8, F8)) -> Drawn {
+fn draw_on_triangles(triangles: &PerLane<TriangleLight>, p: V8, u: (F8, F8)) -> Drawn {
     let (b0, b1) = uniform_triangle_of(u.0, u.1);
     let vertex = |k: usize| triangles.v8(|triangle| triangle.vertices[k]);
-    let vertices = [vertex(0), vertex(1), vertex(2)];
+    let target = triangle_point_of([vertex(0), vertex(1), vertex(2)], b0, b1);
+    let normal = triangles.v8(|triangle| triangle.normal);
     Drawn {
-        target: triangle_point_of(vertices, b0, b1),
-        normal: triangles.v8(|triangle| triangle.normal),
+        target,
+        normal,
         error: triangles.f8(|triangle| triangle.error),
-        area: triangles.f8(|triangle| triangle.area),
+        pdf: solid_angle_pdf_of(p, target, normal, triangles.f8(|triangle| triangle.area)),
         radiance: triangles.v8(|triangle| triangle.radiance),
     }
 }
@@ -209,8 +295,8 @@ pub(super) struct LightLanes {
 }
 
 impl LightLanes {
-    /// `LightSource::sample` for each lane's light: caps and triangles in
-    /// lanes, other lights through the scalar code.
+    /// `LightSource::sample` for each lane's light: area lights in lanes,
+    /// other lights through the scalar code.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(super) fn sample(
@@ -224,20 +310,6 @@ impl LightLanes {
         u: (F8, F8),
         hit: &impl Fn(usize) -> SurfaceHit,
     ) -> LightLanes {
-        // Which lanes drew a light of each kind (all of them where the
-        // scene's lights are all of one kind the lanes sample)
-        let lanes_of = |this: bool, other: bool, is: fn(&Option<LaneLight>) -> bool| match (this, other) {
-            (false, _) => M8::NONE,
-            (true, false) if lights.all_in_lanes => mask,
-            _ => M8::from_fn(|i| is(&lights.lights[pick[i]])).and(mask),
-        };
-        let (has_caps, has_triangles) = (lights.first_cap.is_some(), lights.first_triangle.is_some());
-        let cap_lanes = lanes_of(has_caps, has_triangles, |light| matches!(light, Some(LaneLight::Cap(_))));
-        let triangle_lanes = lanes_of(has_triangles, has_caps, |light| matches!(light, Some(LaneLight::Triangle(_))));
-        let caps = || PerLane::of(lights, pick, lights.first_cap.unwrap_or((CapLight::NONE, true)), LaneLight::cap);
-        let triangles = || {
-            PerLane::of(lights, pick, lights.first_triangle.unwrap_or((TriangleLight::NONE, true)), LaneLight::triangle)
-        };
         let mut out = LightLanes {
             valid: M8::NONE,
             delta: M8::NONE,
@@ -247,17 +319,20 @@ impl LightLanes {
             origin: point,
             t_max: F8::splat(0.0),
         };
-        let drawn = match (cap_lanes.any(), triangle_lanes.any()) {
-            (true, true) => {
-                Some(Drawn::select(cap_lanes, draw_on_caps(&caps(), u), draw_on_triangles(&triangles(), u)))
-            }
-            (true, false) => Some(draw_on_caps(&caps(), u)),
-            (false, true) => Some(draw_on_triangles(&triangles(), u)),
-            (false, false) => None,
-        };
-        let in_lanes = cap_lanes.or(triangle_lanes);
-        if let Some(Drawn { target, normal: light_normal, error: light_error, area, radiance }) = drawn {
-            let pdf = solid_angle_pdf_of(point, target, light_normal, area);
+        let (mut drawn, mut in_lanes) = (None, M8::NONE);
+        if let Some((lanes, caps)) = lights.of_kind(pick, mask, 0, LaneLight::cap) {
+            drawn = Some(draw_on_caps(&caps, point, u).over(lanes, drawn));
+            in_lanes = in_lanes.or(lanes);
+        }
+        if let Some((lanes, spheres)) = lights.of_kind(pick, mask, 1, LaneLight::sphere) {
+            drawn = Some(draw_on_spheres(&spheres, point, u).over(lanes, drawn));
+            in_lanes = in_lanes.or(lanes);
+        }
+        if let Some((lanes, triangles)) = lights.of_kind(pick, mask, 2, LaneLight::triangle) {
+            drawn = Some(draw_on_triangles(&triangles, point, u).over(lanes, drawn));
+            in_lanes = in_lanes.or(lanes);
+        }
+        if let Some(Drawn { target, normal: light_normal, error: light_error, pdf, radiance }) = drawn {
             // The shadow ray (`SurfaceHit::spawn_ray_to`)
             let (origin, wi, t_max) = ray_to(point, error, normal, target, light_error);
             // Emission is one-sided: the light's front must face the point

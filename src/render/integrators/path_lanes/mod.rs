@@ -20,12 +20,13 @@ use glam::Vec3;
 mod lights;
 mod samples;
 
-use lights::{CapLight, LaneLight, LaneLights, LightLanes, TriangleLight};
+use lights::{LaneLights, LightLanes};
 use samples::{CameraSample, CameraSamples};
 
 use super::Counters;
 use crate::faults::{self, Fault};
 use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
+use crate::geometry::{edges_of, shear_of, triangle_hit_of, watertight_hit_of};
 use crate::geometry::{frame_from_z, gamma, intersect_triangle, offset_origin, to_world, Ray, SurfaceHit, Triangle};
 use crate::geometry::{may_reach_of, plane_exit_of, plane_point_of, plane_t_of};
 use crate::render::world::bsdf::{reflect_of, refraction_of, Bsdf, Refraction};
@@ -185,35 +186,6 @@ impl PathLanes {
                 _ => None,
             })
             .collect();
-        let lights = (world.lights.iter().zip(&light_spheres))
-            .map(|(light, sphere)| match (light, sphere) {
-                (&LightSource::Area { radiance, .. }, &Some(i)) => {
-                    let cap = world.emitting_cap(i as usize);
-                    let info = &spheres[i as usize];
-                    (!cap.is_whole()).then(|| {
-                        LaneLight::Cap(CapLight {
-                            center: info.center,
-                            radius: info.radius,
-                            error: info.error,
-                            frame: [cap.frame.x, cap.frame.y, cap.frame.z],
-                            one_minus_cos: cap.one_minus_cos,
-                            area: cap.area(info.radius),
-                            radiance,
-                        })
-                    })
-                }
-                (LightSource::Area { radiance, emitter: emitter @ Emitter::Triangle { shape, .. }, .. }, _) => {
-                    Some(LaneLight::Triangle(TriangleLight {
-                        vertices: shape.vertices,
-                        normal: shape.normal,
-                        area: shape.area(),
-                        error: emitter.error(),
-                        radiance: *radiance,
-                    }))
-                }
-                _ => None,
-            })
-            .collect();
         let occluder = |i: usize| Occluder {
             center: spheres[i].center,
             radius2: spheres[i].radius2,
@@ -228,7 +200,7 @@ impl PathLanes {
             triangles: world.triangles.iter().map(|(triangle, _)| *triangle).collect(),
             triangle_planes: world.light_plane.clone(),
             surfaces,
-            lights: LaneLights::new(lights),
+            lights: LaneLights::new(world),
             light_spheres,
             light_planes,
             background: world.background,
@@ -381,19 +353,23 @@ impl PathLanes {
                 k = k + 1.0;
             }
         }
-        // Triangles last, as both do: lane by lane, for the lanes whose
-        // ray may reach the triangle's ball (tested in the lanes)
+        // Triangles last, as both do: the watertight test in the lanes
+        // whose ray may reach the triangle's ball
         let first_triangle = first_plane + self.planes.len() as f32;
-        let mut triangle_hits = [None; LANES];
+        let (mut triangle_point, mut triangle_normal, mut triangle_error) =
+            (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
         for (j, triangle) in self.triangles.iter().enumerate() {
             let near = self.may_reach(j, active, origin, direction, t_hit);
-            for lane in (0..LANES).filter(|&i| near.test(i)) {
-                let ray = Ray::new(origin.lane(lane), direction.lane(lane));
-                if let Some(hit) = intersect_triangle(&ray, triangle, t_hit.lane(lane)) {
-                    t_hit.set_lane(lane, hit.t);
-                    index.set_lane(lane, first_triangle + j as f32);
-                    triangle_hits[lane] = Some(hit);
-                }
+            if !near.any() {
+                continue;
+            }
+            let (hits, t, point, error) = Self::triangle_hits(triangle, near, origin, direction, t_hit);
+            if hits.any() {
+                t_hit = hits.select(t, t_hit);
+                index = hits.select(F8::splat(first_triangle + j as f32), index);
+                triangle_point = hits.select_v(point, triangle_point);
+                triangle_normal = hits.select_v(V8::splat(triangle.normal), triangle_normal);
+                triangle_error = hits.select(error, triangle_error);
             }
         }
         let found = active.and(t_hit.lt(F8::splat(f32::INFINITY)));
@@ -430,12 +406,11 @@ impl PathLanes {
             normal = on_plane.select_v(plane_normal, normal);
             error = on_plane.select(e, error);
         }
-        for (lane, hit) in triangle_hits.iter().enumerate() {
-            if let Some(hit) = hit.filter(|_| alive.test(lane)) {
-                point.set_lane(lane, hit.point);
-                normal.set_lane(lane, hit.normal);
-                error.set_lane(lane, hit.error);
-            }
+        let on_triangle = alive.and_not(index.lt(F8::splat(first_triangle)));
+        if on_triangle.any() {
+            point = on_triangle.select_v(triangle_point, point);
+            normal = on_triangle.select_v(triangle_normal, normal);
+            error = on_triangle.select(triangle_error, error);
         }
         let wo = -direction;
         let hit = |i: usize| SurfaceHit {
@@ -600,6 +575,36 @@ impl PathLanes {
         }
     }
 
+    /// `intersect_triangle` for the lanes of `near` (those `may_reach`
+    /// let through): which hit, and their distance, point and error bound.
+    /// Lanes on an edge, where the scalar code redoes the edge functions in
+    /// f64, take the scalar code.
+    #[inline(always)]
+    fn triangle_hits(triangle: &Triangle, near: M8, origin: V8, direction: V8, t_max: F8) -> (M8, F8, V8, F8) {
+        let [a, b, c] = triangle.vertices;
+        let vertices = [V8::splat(a), V8::splat(b), V8::splat(c)];
+        let (sheared, sz) = shear_of(origin, direction, vertices);
+        let edges = edges_of(sheared);
+        let zero = F8::splat(0.0);
+        let on_edge = near.and(edges[0].eq(zero).or(edges[1].eq(zero)).or(edges[2].eq(zero)));
+        let (mut t, hit, barycentrics) = watertight_hit_of(sheared, edges, sz, t_max);
+        let mut hits = near.and_not(on_edge).and(hit);
+        let (mut point, mut error) = match hits.any() {
+            true => triangle_hit_of(vertices, barycentrics),
+            false => (V8::splat(Vec3::ZERO), zero),
+        };
+        for lane in (0..LANES).filter(|&i| on_edge.test(i)) {
+            let ray = Ray::new(origin.lane(lane), direction.lane(lane));
+            if let Some(hit) = intersect_triangle(&ray, triangle, t_max.lane(lane)) {
+                hits.set(lane, true);
+                t.set_lane(lane, hit.t);
+                point.set_lane(lane, hit.point);
+                error.set_lane(lane, hit.error);
+            }
+        }
+        (hits, t, point, error)
+    }
+
     /// Lanes of `mask` whose ray may reach triangle `j` before `t_max`
     /// (`intersect_triangle`'s first test, which it repeats).
     #[inline(always)]
@@ -650,13 +655,9 @@ impl PathLanes {
         // the plane of the light's own triangle (`Occluders::blocks`)
         for (j, (triangle, plane)) in self.triangles.iter().zip(&self.triangle_planes).enumerate() {
             let near = self.may_reach(j, mask.and_not(blocked), origin, direction, t_max);
-            for lane in (0..LANES).filter(|&i| near.test(i)) {
-                let ray = Ray::new(origin.lane(lane), direction.lane(lane));
-                if self.light_planes[pick[lane]] != Some(*plane)
-                    && intersect_triangle(&ray, triangle, t_max.lane(lane)).is_some()
-                {
-                    blocked.set(lane, true);
-                }
+            let near = near.and_not(M8::from_fn(|i| self.light_planes[pick[i]] == Some(*plane)));
+            if near.any() {
+                blocked = blocked.or(Self::triangle_hits(triangle, near, origin, direction, t_max).0);
             }
         }
         mask.and(blocked)
@@ -781,5 +782,56 @@ mod tests {
         assert_eq!(bits(&got), bits(&expected));
         assert_eq!(lane_counters.rays, scalar_counters.rays);
         assert!(expected.iter().filter(|v| v.max_element() > 0.0).count() > 200, "samples carried light");
+    }
+
+    /// The lanes' watertight test is `intersect_triangle`, bit for bit: on
+    /// random rays, and on rays straight down onto a quad's edges and
+    /// vertices, where edge functions are exactly zero and the scalar code
+    /// redoes them in f64.
+    #[test]
+    fn triangle_hits_are_the_scalar_ones() {
+        use crate::render::world::rng::Sampler;
+        let quad =
+            [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+        let triangles = [Triangle::new(quad[0], quad[1], quad[3]), Triangle::new(quad[1], quad[2], quad[3])];
+        let mut rays = Vec::new();
+        for i in 0..=16 {
+            for j in 0..=16 {
+                let at = Vec3::new(i as f32 / 16.0 - 0.25, j as f32 / 16.0 - 0.25, 1.0);
+                rays.push((at, -Vec3::Z, if (i + j) % 3 == 0 { 0.5 } else { f32::INFINITY }));
+            }
+        }
+        let mut rng = Sampler::new(0, 0, 7);
+        while rays.len() % LANES != 0 || rays.len() < 800 {
+            let origin = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0 - 2.0;
+            let target = Vec3::new(rng.next_f32() * 1.4 - 0.2, rng.next_f32() * 1.4 - 0.2, 0.0);
+            rays.push((origin, (target - origin).normalize(), 10.0));
+        }
+        let (mut on_edges, mut hits_seen, mut misses_seen) = (0, 0, 0);
+        for triangle in &triangles {
+            let (center, radius) = triangle.bound();
+            for batch in rays.chunks(LANES) {
+                let origin = V8::from_fn(|i| batch[i].0);
+                let direction = V8::from_fn(|i| batch[i].1);
+                let t_max = F8::from_fn(|i| batch[i].2);
+                let near = may_reach_of(origin, direction, V8::splat(center), F8::splat(radius), t_max);
+                let (hits, t, point, error) = PathLanes::triangle_hits(triangle, near, origin, direction, t_max);
+                for (i, &(o, d, t_max)) in batch.iter().enumerate() {
+                    let vertices = triangle.vertices.map(crate::geometry::real::V3::from);
+                    on_edges += edges_of(shear_of(o.into(), d.into(), vertices).0).contains(&0.0) as u32;
+                    let expected = intersect_triangle(&Ray::new(o, d), triangle, t_max);
+                    assert_eq!(hits.test(i), expected.is_some(), "ray {o} {d}");
+                    if let Some(hit) = expected {
+                        hits_seen += 1;
+                        assert_eq!(t.lane(i).to_bits(), hit.t.to_bits());
+                        assert_eq!(point.lane(i).to_array().map(f32::to_bits), hit.point.to_array().map(f32::to_bits));
+                        assert_eq!(error.lane(i).to_bits(), hit.error.to_bits());
+                    } else {
+                        misses_seen += 1;
+                    }
+                }
+            }
+        }
+        assert!(on_edges > 50 && hits_seen > 300 && misses_seen > 300, "{on_edges} {hits_seen} {misses_seen}");
     }
 }
