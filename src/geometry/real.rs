@@ -48,6 +48,8 @@ pub trait Real:
     /// Unordered: true where either is NaN.
     fn ne(self, other: Self) -> Self::Mask;
     fn is_finite(self) -> Self::Mask;
+    /// `f32::powf` (libm's), lane by lane.
+    fn powf(self, exponent: Self) -> Self;
     /// `a` where `mask` holds, `b` elsewhere.
     fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
     /// The spacing of floats in `self`'s binade, 23 bits below its exponent
@@ -137,6 +139,10 @@ impl Real for f32 {
     #[inline(always)]
     fn is_finite(self) -> bool {
         f32::is_finite(self)
+    }
+    #[inline(always)]
+    fn powf(self, exponent: f32) -> f32 {
+        f32::powf(self, exponent)
     }
     #[inline(always)]
     fn select(mask: bool, a: f32, b: f32) -> f32 {
@@ -230,6 +236,10 @@ impl Real for Vec4 {
     #[inline(always)]
     fn is_finite(self) -> BVec4A {
         self.is_finite_mask()
+    }
+    #[inline(always)]
+    fn powf(self, exponent: Self) -> Self {
+        Vec4::new(self.x.powf(exponent.x), self.y.powf(exponent.y), self.z.powf(exponent.z), self.w.powf(exponent.w))
     }
     #[inline(always)]
     fn select(mask: BVec4A, a: Self, b: Self) -> Self {

@@ -10,7 +10,9 @@ use crate::faults::{self, Fault};
 use crate::geometry::real::{Real, V3};
 use crate::geometry::Frame;
 use crate::render::world::rng::Sampler;
-use crate::render::world::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, power_cosine, power_cosine_pdf};
+use crate::render::world::sampling::{
+    cosine_hemisphere, cosine_hemisphere_pdf, cosine_hemisphere_pdf_of, power_cosine, power_cosine_pdf_of,
+};
 use crate::scene::{MaterialModel, Rgb};
 
 /// What a path carries through refraction: camera paths carry radiance, which
@@ -94,7 +96,7 @@ pub fn refraction_of<R: Real>(wo: V3<R>, n: V3<R>, eta_i: R, eta_t: R) -> Refrac
 /// Exact normalisation of the Blinn–Phong lobe at normal incidence
 /// (Giesen 2009); the common (n + 8)/8π exceeds energy 1 for n > 4.
 #[inline]
-fn blinn_normalisation(exponent: f32) -> f32 {
+pub(crate) fn blinn_normalisation(exponent: f32) -> f32 {
     (exponent + 2.0) * (exponent + 4.0) / (8.0 * PI * ((-exponent * 0.5).exp2() + exponent))
 }
 
@@ -123,6 +125,49 @@ pub enum Bsdf {
     },
     /// Emitters reflect nothing.
     Black,
+}
+
+/// Phong's f (the thesis' lobe, normalised): diffuse plus (n + 2)/2π ·
+/// cosⁿ α about the mirror direction, for directions above the surface.
+#[inline(always)]
+pub fn phong_of<R: Real>(kd: V3<R>, ks: V3<R>, exponent: R, wo: V3<R>, wi: V3<R>, n: V3<R>) -> V3<R> {
+    let cos_alpha = reflect_of(wo, n).dot(wi).max(R::splat(0.0));
+    let lobe = ks * ((exponent + 2.0) * 0.5 * FRAC_1_PI * cos_alpha.powf(exponent));
+    let lobe = if faults::active(Fault::PhongLobeDim) { lobe * R::splat(0.97) } else { lobe };
+    kd * R::splat(FRAC_1_PI) + lobe
+}
+
+/// Blinn–Phong's f: diffuse plus cosⁿ of the half vector, normalised by
+/// `normalisation` (`blinn_normalisation` of the exponent).
+#[inline(always)]
+pub fn blinn_phong_of<R: Real>(
+    kd: V3<R>,
+    ks: V3<R>,
+    exponent: R,
+    normalisation: R,
+    wo: V3<R>,
+    wi: V3<R>,
+    n: V3<R>,
+) -> V3<R> {
+    let h = (wo + wi).normalize();
+    kd * R::splat(FRAC_1_PI) + ks * (normalisation * n.dot(h).max(R::splat(0.0)).powf(exponent))
+}
+
+/// The pdf of Phong's sampling: the diffuse lobe with probability `pd`,
+/// else cosⁿ about the mirror direction.
+#[inline(always)]
+pub fn phong_pdf_of<R: Real>(pd: R, exponent: R, wo: V3<R>, wi: V3<R>, n: V3<R>) -> R {
+    let specular = power_cosine_pdf_of(reflect_of(wo, n).dot(wi), exponent);
+    pd * cosine_hemisphere_pdf_of(wi.dot(n)) + (R::splat(1.0) - pd) * specular
+}
+
+/// The pdf of Blinn–Phong's sampling: the diffuse lobe with probability
+/// `pd`, else a half vector cosⁿ about the normal, turned into wi's density.
+#[inline(always)]
+pub fn blinn_phong_pdf_of<R: Real>(pd: R, exponent: R, wo: V3<R>, wi: V3<R>, n: V3<R>) -> R {
+    let h = (wo + wi).normalize();
+    let specular = power_cosine_pdf_of(n.dot(h), exponent) / (wo.dot(h) * 4.0);
+    pd * cosine_hemisphere_pdf_of(wi.dot(n)) + (R::splat(1.0) - pd) * specular
 }
 
 impl Bsdf {
@@ -161,7 +206,7 @@ impl Bsdf {
 
     /// Probability of choosing the diffuse lobe of a Phong-like BRDF.
     #[inline]
-    fn diffuse_probability(kd: Rgb, ks: Rgb) -> f32 {
+    pub(crate) fn diffuse_probability(kd: Rgb, ks: Rgb) -> f32 {
         let (d, s) = (luminance(kd), luminance(ks));
         if d + s > 0.0 {
             d / (d + s)
@@ -179,13 +224,11 @@ impl Bsdf {
         match *self {
             Bsdf::Lambert { albedo } => albedo * FRAC_1_PI,
             Bsdf::Phong { kd, ks, exponent } => {
-                let cos_alpha = reflect(wo, n).dot(wi).max(0.0);
-                let lobe = ks * ((exponent + 2.0) * 0.5 * FRAC_1_PI * cos_alpha.powf(exponent));
-                kd * FRAC_1_PI + if faults::active(Fault::PhongLobeDim) { lobe * 0.97 } else { lobe }
+                phong_of(kd.into(), ks.into(), exponent, wo.into(), wi.into(), n.into()).into()
             }
             Bsdf::BlinnPhong { kd, ks, exponent } => {
-                let h = (wo + wi).normalize();
-                kd * FRAC_1_PI + ks * (blinn_normalisation(exponent) * n.dot(h).max(0.0).powf(exponent))
+                let normalisation = blinn_normalisation(exponent);
+                blinn_phong_of(kd.into(), ks.into(), exponent, normalisation, wo.into(), wi.into(), n.into()).into()
             }
             Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::Black => Rgb::ZERO,
         }
@@ -198,16 +241,12 @@ impl Bsdf {
             return 0.0;
         }
         match *self {
-            Bsdf::Lambert { .. } => cosine_hemisphere_pdf(wi.dot(n)),
+            Bsdf::Lambert { .. } => cosine_hemisphere_pdf_of(wi.dot(n)),
             Bsdf::Phong { kd, ks, exponent } => {
-                let pd = Self::diffuse_probability(kd, ks);
-                pd * cosine_hemisphere_pdf(wi.dot(n)) + (1.0 - pd) * power_cosine_pdf(reflect(wo, n).dot(wi), exponent)
+                phong_pdf_of(Self::diffuse_probability(kd, ks), exponent, wo.into(), wi.into(), n.into())
             }
             Bsdf::BlinnPhong { kd, ks, exponent } => {
-                let pd = Self::diffuse_probability(kd, ks);
-                let h = (wo + wi).normalize();
-                let specular = power_cosine_pdf(n.dot(h), exponent) / (4.0 * wo.dot(h));
-                pd * cosine_hemisphere_pdf(wi.dot(n)) + (1.0 - pd) * specular
+                blinn_phong_pdf_of(Self::diffuse_probability(kd, ks), exponent, wo.into(), wi.into(), n.into())
             }
             Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::Black => 0.0,
         }

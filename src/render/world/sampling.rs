@@ -97,7 +97,13 @@ pub fn cosine_hemisphere_of<R: Real>(u0: R, u1: R) -> V3<R> {
 
 #[inline]
 pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
-    cos_theta.max(0.0) * FRAC_1_PI
+    cosine_hemisphere_pdf_of(cos_theta)
+}
+
+/// `cosine_hemisphere_pdf` for one direction or several.
+#[inline(always)]
+pub fn cosine_hemisphere_pdf_of<R: Real>(cos_theta: R) -> R {
+    cos_theta.max(R::splat(0.0)) * FRAC_1_PI
 }
 
 /// Uniform direction on the unit sphere; pdf = 1 / 4π.
@@ -147,19 +153,28 @@ pub fn uniform_cone_pdf_of<R: Real>(one_minus_cos_max: R) -> R {
 /// Direction about +z with pdf ∝ cosⁿθ: pdf = (n + 1)/(2π) · cosⁿθ.
 #[inline]
 pub fn power_cosine(u: Vec2, exponent: f32) -> Vec3 {
-    let cos_theta = u.x.powf(1.0 / (exponent + 1.0));
-    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let (sin, cos) = sin_cos(2.0 * PI * u.y);
-    Vec3::new(sin_theta * cos, sin_theta * sin, cos_theta)
+    power_cosine_of(u.x, u.y, exponent).into()
+}
+
+/// `power_cosine` for one sample or several.
+#[inline(always)]
+pub fn power_cosine_of<R: Real>(u0: R, u1: R, exponent: R) -> V3<R> {
+    let cos_theta = u0.powf(R::splat(1.0) / (exponent + 1.0));
+    let sin_theta = (R::splat(1.0) - cos_theta * cos_theta).max(R::splat(0.0)).sqrt();
+    let (sin, cos) = sin_cos_of(u1 * (2.0 * PI));
+    V3::new(sin_theta * cos, sin_theta * sin, cos_theta)
 }
 
 #[inline]
 pub fn power_cosine_pdf(cos_theta: f32, exponent: f32) -> f32 {
-    if cos_theta <= 0.0 {
-        0.0
-    } else {
-        (exponent + 1.0) * 0.5 * FRAC_1_PI * cos_theta.powf(exponent)
-    }
+    power_cosine_pdf_of(cos_theta, exponent)
+}
+
+/// `power_cosine_pdf` for one direction or several.
+#[inline(always)]
+pub fn power_cosine_pdf_of<R: Real>(cos_theta: R, exponent: R) -> R {
+    let pdf = (exponent + 1.0) * 0.5 * FRAC_1_PI * cos_theta.powf(exponent);
+    R::select(cos_theta.le(R::splat(0.0)), R::splat(0.0), pdf)
 }
 
 /// Uniform barycentrics (b0, b1) on a triangle (b2 = 1 − b0 − b1).

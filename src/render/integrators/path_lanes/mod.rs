@@ -17,9 +17,11 @@ use std::f32::consts::FRAC_1_PI;
 
 use glam::Vec3;
 
+mod glossy;
 mod lights;
 mod samples;
 
+use glossy::GlossyLanes;
 use lights::{LaneLights, LightLanes};
 use samples::{CameraSample, CameraSamples};
 
@@ -29,11 +31,11 @@ use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wal
 use crate::geometry::{edges_of, shear_of, triangle_hit_of, watertight_hit_of};
 use crate::geometry::{frame_from_z, gamma, intersect_triangle, offset_origin, to_world, Ray, SurfaceHit, Triangle};
 use crate::geometry::{may_reach_of, plane_exit_of, plane_point_of, plane_t_of};
-use crate::render::world::bsdf::{reflect_of, refraction_of, Bsdf, Refraction};
+use crate::render::world::bsdf::{blinn_normalisation, reflect_of, refraction_of, Bsdf, Refraction};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSource};
-use crate::render::world::sampling::{cosine_hemisphere_of, power_heuristic, power_heuristic_of};
+use crate::render::world::sampling::{cosine_hemisphere_of, power_heuristic, power_heuristic_of, uniform_sphere_pdf};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::{MaterialModel, Rgb};
 
@@ -47,16 +49,24 @@ const LAMBERT: f32 = 0.0;
 const MIRROR: f32 = 1.0;
 const GLASS: f32 = 2.0;
 const EMITTER: f32 = 3.0;
+const PHONG: f32 = 4.0;
+const BLINN_PHONG: f32 = 5.0;
 
 /// What shading needs of a shape's material.
 #[derive(Clone, Copy, Debug)]
 struct Surface {
     object: u32,
-    /// `LAMBERT`, `MIRROR`, `GLASS` or `EMITTER`.
+    /// `LAMBERT`, `MIRROR`, `GLASS`, `EMITTER`, `PHONG` or `BLINN_PHONG`.
     kind: f32,
-    /// Albedo, tint or radiance.
+    /// Albedo, tint, radiance or a glossy surface's diffuse part.
     color: Rgb,
     ior: f32,
+    /// A glossy surface's lobe: its colour, exponent, the chance of
+    /// sampling the diffuse part and Blinn–Phong's normalisation.
+    specular: Rgb,
+    exponent: f32,
+    diffuse_probability: f32,
+    normalisation: f32,
 }
 
 /// One sphere, as the hit loop meets it.
@@ -118,30 +128,46 @@ pub struct PathLanes {
 }
 
 impl PathLanes {
-    /// For worlds of spheres, planes and triangles with Lambert, mirror,
-    /// glass and emissive materials; None for anything else (the scalar
-    /// tracer renders it).
+    /// For worlds of spheres, planes and triangles (`None` for a world
+    /// of none).
     pub fn new(world: &World) -> Option<Self> {
-        // The background as a light is sampled one path at a time
-        if world.lights.iter().any(|l| matches!(l, LightSource::Background { .. })) {
-            return None;
-        }
         let surface = |object: u32| {
             let material = &world.materials[world.objects[object as usize].material as usize];
-            let (kind, color, ior) = match (Bsdf::new(material), material) {
-                (Bsdf::Lambert { albedo }, _) => (LAMBERT, albedo, 1.0),
-                (Bsdf::Mirror { tint }, _) => (MIRROR, tint, 1.0),
-                (Bsdf::Glass { ior, tint }, _) => (GLASS, tint, ior),
-                (Bsdf::Black, MaterialModel::Emissive { radiance }) => (EMITTER, *radiance, 1.0),
-                _ => return None,
+            let plain = |kind, color, ior| Surface {
+                object,
+                kind,
+                color,
+                ior,
+                specular: Rgb::ZERO,
+                exponent: 0.0,
+                diffuse_probability: 1.0,
+                normalisation: 0.0,
             };
-            Some(Surface { object, kind, color, ior })
+            let glossy = |kind, kd, ks, exponent, normalisation| Surface {
+                specular: ks,
+                exponent,
+                diffuse_probability: Bsdf::diffuse_probability(kd, ks),
+                normalisation,
+                ..plain(kind, kd, 1.0)
+            };
+            match (Bsdf::new(material), material) {
+                (Bsdf::Lambert { albedo }, _) => plain(LAMBERT, albedo, 1.0),
+                (Bsdf::Mirror { tint }, _) => plain(MIRROR, tint, 1.0),
+                (Bsdf::Glass { ior, tint }, _) => plain(GLASS, tint, ior),
+                (Bsdf::Phong { kd, ks, exponent }, _) => glossy(PHONG, kd, ks, exponent, 0.0),
+                (Bsdf::BlinnPhong { kd, ks, exponent }, _) => {
+                    glossy(BLINN_PHONG, kd, ks, exponent, blinn_normalisation(exponent))
+                }
+                (Bsdf::Black, MaterialModel::Emissive { radiance }) => plain(EMITTER, *radiance, 1.0),
+                // Reflects nothing, emits nothing: an emitter gone dark
+                (Bsdf::Black, _) => plain(EMITTER, Rgb::ZERO, 1.0),
+            }
         };
         let s = &world.spheres;
         let objects = s.object.iter().copied();
         let objects = objects.chain(world.planes.iter().map(|p| p.object));
         let surfaces = objects.chain(world.triangles.iter().map(|(_, object)| *object)).map(surface);
-        let surfaces = surfaces.collect::<Option<Vec<_>>>()?;
+        let surfaces: Vec<_> = surfaces.collect();
         if surfaces.is_empty() {
             return None;
         }
@@ -374,8 +400,13 @@ impl PathLanes {
         }
         let found = active.and(t_hit.lt(F8::splat(f32::INFINITY)));
         let missed = active.and_not(found);
+        let light_count = world.lights.len();
+        let pick_pdf = 1.0 / light_count.max(1) as f32;
         if missed.any() {
-            let lit = st.radiance + st.throughput * V8::splat(self.background);
+            // The background, weighted against sampling it as a light
+            let mis = power_heuristic_of(st.last_pdf, F8::splat(pick_pdf * uniform_sphere_pdf()));
+            let weight = st.after_delta.select(F8::splat(1.0), mis);
+            let lit = st.radiance + st.throughput * V8::splat(self.background) * weight;
             st.radiance = missed.select_v(lit, st.radiance);
         }
         let alive = found;
@@ -387,6 +418,9 @@ impl PathLanes {
         let code = F8::from_fn(|i| surface[i].kind);
         let kind = |k: f32| code.eq(F8::splat(k)).and(alive);
         let (lambert, mirror, glass, emissive) = (kind(LAMBERT), kind(MIRROR), kind(GLASS), kind(EMITTER));
+        let glossy = GlossyLanes::new(&surface, code, alive);
+        // What next-event estimation shades
+        let diffuse = lambert.or(glossy.mask());
         let color = V8::from_fn(|i| surface[i].color);
         let on_sphere = alive.and(index.lt(F8::splat(first_plane)));
         let on_plane = alive.and_not(on_sphere).and(index.lt(F8::splat(first_triangle)));
@@ -421,8 +455,6 @@ impl PathLanes {
         };
 
         // Emission reached by this ray, weighted against light sampling (rare: lane by lane)
-        let light_count = world.lights.len();
-        let pick_pdf = 1.0 / light_count.max(1) as f32;
         let glowing = emissive.and(normal.dot(wo).gt(F8::splat(0.0))).and(color.nonzero());
         for lane in (0..LANES).filter(|&i| glowing.test(i)) {
             let object = surface[lane].object;
@@ -441,19 +473,22 @@ impl PathLanes {
         let zero = F8::splat(0.0);
 
         // Next-event estimation toward one light, chosen uniformly
-        if light_count > 0 && lambert.any() {
+        if light_count > 0 && diffuse.any() {
             let pick: [usize; LANES] = if light_count == 1 {
                 [0; LANES]
             } else {
-                let u_pick = st.rng.next_f32(lambert);
+                let u_pick = st.rng.next_f32(diffuse);
                 let u_pick = u_pick.to_array();
                 lanes::each(|i| ((u_pick[i] * light_count as f32) as usize).min(light_count - 1))
             };
-            let u = st.rng.next_2d(lambert);
-            let light = LightLanes::sample(&self.lights, world, &pick, lambert, point, normal, error, u, &hit);
-            // f = albedo / π where both directions are above the surface
+            let u = st.rng.next_2d(diffuse);
+            let light = LightLanes::sample(&self.lights, world, &pick, diffuse, point, normal, error, u, &hit);
+            // f (Lambert's albedo / π) where both directions are above the surface
             let above = !light.wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
-            let f = color * F8::splat(FRAC_1_PI);
+            let mut f = color * F8::splat(FRAC_1_PI);
+            if glossy.mask().and(light.valid).and(above).any() {
+                f = glossy.mask().select_v(glossy.f(wo, light.wi, facing), f);
+            }
             let shade = light.valid.and(above).and(f.nonzero());
             counters.rays += shade.count();
             if shade.any() {
@@ -461,7 +496,10 @@ impl PathLanes {
                 let lit = shade.and_not(blocked);
                 if lit.any() {
                     let cos = light.wi.dot(facing);
-                    let bsdf_pdf = cos.max(zero) * FRAC_1_PI;
+                    let mut bsdf_pdf = cos.max(zero) * FRAC_1_PI;
+                    if glossy.mask().and(lit).any() {
+                        bsdf_pdf = glossy.mask().select(glossy.pdf(wo, light.wi, facing), bsdf_pdf);
+                    }
                     let mis = power_heuristic_of(pick_pdf * light.pdf, bsdf_pdf);
                     let weight = light.delta.select(F8::splat(1.0), mis);
                     let term = st.throughput * f * light.value * (cos * weight / pick_pdf);
@@ -484,6 +522,15 @@ impl PathLanes {
             pdf = ok.select(cos.max(zero) * FRAC_1_PI, pdf);
             scattered = scattered.or(ok);
         }
+        if glossy.mask().any() {
+            let u_lobe = st.rng.next_f32(glossy.mask());
+            let u = st.rng.next_2d(glossy.mask());
+            let (ok, w, f_cos_over_pdf, p) = glossy.sample(wo, facing, u_lobe, u);
+            wi = ok.select_v(w, wi);
+            weight = ok.select_v(f_cos_over_pdf, weight);
+            pdf = ok.select(p, pdf);
+            scattered = scattered.or(ok);
+        }
         if glass.any() {
             let ior = F8::from_fn(|i| surface[i].ior);
             let entering = wo.dot(normal).gt(zero);
@@ -504,7 +551,7 @@ impl PathLanes {
             return done;
         }
         st.throughput = go.select_v(st.throughput * weight, st.throughput);
-        st.after_delta = lambert.select_mask(M8::NONE, go.select_mask(M8::ALL, st.after_delta));
+        st.after_delta = diffuse.select_mask(M8::NONE, go.select_mask(M8::ALL, st.after_delta));
         st.last_pdf = go.select(pdf, st.last_pdf);
         st.last_point = go.select_v(point, st.last_point);
 

@@ -196,6 +196,11 @@ impl Real for F8 {
         F8::is_finite(self)
     }
     #[inline(always)]
+    fn powf(self, exponent: F8) -> F8 {
+        let (x, e) = (self.to_array(), exponent.to_array());
+        F8::from_array(each(|i| x[i].powf(e[i])))
+    }
+    #[inline(always)]
     fn select(mask: M8, a: F8, b: F8) -> F8 {
         mask.select(a, b)
     }

@@ -1,0 +1,91 @@
+//! Phong and Blinn–Phong in eight lanes: `Bsdf`'s evaluation, pdf and
+//! sampling for the lanes whose surface is glossy, on the functions the
+//! scalar `Bsdf` calls.
+
+use glam::Vec3;
+
+use super::{Surface, BLINN_PHONG, PHONG};
+use crate::geometry::{frame_from_z, to_world};
+use crate::render::world::bsdf::{blinn_phong_of, blinn_phong_pdf_of, phong_of, phong_pdf_of, reflect_of};
+use crate::render::world::lanes::{F8, LANES, M8, V8};
+use crate::render::world::sampling::{cosine_hemisphere_of, power_cosine_of};
+
+/// The glossy lanes of a bounce and their surfaces' lobes.
+pub(super) struct GlossyLanes {
+    phong: M8,
+    blinn_phong: M8,
+    kd: V8,
+    ks: V8,
+    exponent: F8,
+    diffuse_probability: F8,
+    normalisation: F8,
+}
+
+impl GlossyLanes {
+    /// The lanes of `alive` on a Phong or Blinn–Phong surface.
+    #[inline(always)]
+    pub(super) fn new(surface: &[&Surface; LANES], code: F8, alive: M8) -> Self {
+        GlossyLanes {
+            phong: code.eq(F8::splat(PHONG)).and(alive),
+            blinn_phong: code.eq(F8::splat(BLINN_PHONG)).and(alive),
+            kd: V8::from_fn(|i| surface[i].color),
+            ks: V8::from_fn(|i| surface[i].specular),
+            exponent: F8::from_fn(|i| surface[i].exponent),
+            diffuse_probability: F8::from_fn(|i| surface[i].diffuse_probability),
+            normalisation: F8::from_fn(|i| surface[i].normalisation),
+        }
+    }
+
+    #[inline(always)]
+    pub(super) fn mask(&self) -> M8 {
+        self.phong.or(self.blinn_phong)
+    }
+
+    /// `Bsdf::eval` for `wo` and `wi` above the surface of normal `n`.
+    #[inline(always)]
+    pub(super) fn f(&self, wo: V8, wi: V8, n: V8) -> V8 {
+        let mut f = V8::splat(Vec3::ZERO);
+        if self.phong.any() {
+            f = self.phong.select_v(phong_of(self.kd, self.ks, self.exponent, wo, wi, n), f);
+        }
+        if self.blinn_phong.any() {
+            let blinn_phong = blinn_phong_of(self.kd, self.ks, self.exponent, self.normalisation, wo, wi, n);
+            f = self.blinn_phong.select_v(blinn_phong, f);
+        }
+        f
+    }
+
+    /// `Bsdf::pdf` for `wo` and `wi` above the surface of normal `n`.
+    #[inline(always)]
+    pub(super) fn pdf(&self, wo: V8, wi: V8, n: V8) -> F8 {
+        let mut pdf = F8::splat(0.0);
+        if self.phong.any() {
+            pdf = self.phong.select(phong_pdf_of(self.diffuse_probability, self.exponent, wo, wi, n), pdf);
+        }
+        if self.blinn_phong.any() {
+            let blinn_phong = blinn_phong_pdf_of(self.diffuse_probability, self.exponent, wo, wi, n);
+            pdf = self.blinn_phong.select(blinn_phong, pdf);
+        }
+        pdf
+    }
+
+    /// `Bsdf::sample` from the lobe draw `u_lobe` and the direction draw
+    /// (u0, u1): which lanes scattered, with their direction, weight
+    /// (f·cos/pdf) and pdf.
+    #[inline(always)]
+    pub(super) fn sample(&self, wo: V8, facing: V8, u_lobe: F8, (u0, u1): (F8, F8)) -> (M8, V8, V8, F8) {
+        let zero = F8::splat(0.0);
+        let diffuse = to_world(frame_from_z(facing), cosine_hemisphere_of(u0, u1));
+        let lobe = power_cosine_of(u0, u1, self.exponent);
+        let about_mirror = to_world(frame_from_z(reflect_of(wo, facing)), lobe);
+        let about_half = reflect_of(wo, to_world(frame_from_z(facing), lobe));
+        let specular = self.phong.select_v(about_mirror, about_half);
+        let wi = u_lobe.lt(self.diffuse_probability).select_v(diffuse, specular);
+        // The pdf is 0 below the surface, and a direction of pdf 0 ends the path
+        let below = wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
+        let pdf = below.select(zero, self.pdf(wo, wi, facing));
+        let scattered = self.mask().and_not(pdf.le(zero));
+        let weight = self.f(wo, wi, facing) * (wi.dot(facing) / pdf);
+        (scattered, wi, weight, pdf)
+    }
+}
