@@ -100,6 +100,19 @@ fn other_lights_bit_for_bit() {
         falloff_exponent: 4.0,
     };
     scene.lights.push(light(spot, 3000.0));
+    // A hard-edged spot (exponent 0) and a point light with the thesis'
+    // attenuation, 1/(a·d² + b·d + c)
+    let hard = LightKind::Spot {
+        position: Vec3::new(20.0, 75.0, 90.0),
+        direction: Vec3::new(0.3, -1.0, 0.0),
+        cone_angle_degrees: 40.0,
+        falloff_exponent: 0.0,
+    };
+    scene.lights.push(Light { name: "hard spot".into(), ..light(hard, 2000.0) });
+    let mut near = light(LightKind::Point { position: Vec3::new(50.0, 20.0, 120.0) }, 50.0);
+    near.name = "near point".into();
+    near.attenuation = Attenuation { a: 0.001, b: 0.05, c: 0.5 };
+    scene.lights.push(near);
     // A small glowing ball inside the room: sampled as a whole sphere
     let mut glow = scene.objects[8].clone();
     glow.name = "glow".into();

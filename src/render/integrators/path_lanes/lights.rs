@@ -1,16 +1,17 @@
 //! Light sampling in eight lanes: area lights (sphere caps, whole spheres
-//! and triangles) drawn in the lanes, any other light through the scalar
-//! code lane by lane.
+//! and triangles), points, spots and directional lights in the lanes, the
+//! background through the scalar code lane by lane.
 
 use glam::{Vec2, Vec3};
 
+use crate::geometry::real::Real;
 use crate::geometry::sphere::nearest_root;
-use crate::geometry::{frame_from_z, ray_to, to_world, SurfaceHit};
+use crate::geometry::{frame_from_z, offset_origin, ray_to, to_world, SurfaceHit};
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
 use crate::render::world::light::{solid_angle_pdf_of, triangle_point_of, Emitter, LightSource};
 use crate::render::world::sampling::{uniform_cone_of, uniform_cone_pdf_of, uniform_triangle_of};
 use crate::render::world::World;
-use crate::scene::Rgb;
+use crate::scene::{Attenuation, Rgb};
 
 /// An area light as the lanes draw it (`sample_area`).
 #[derive(Clone, Copy, Debug)]
@@ -22,6 +23,10 @@ enum LaneLight {
     Sphere(SphereLight),
     /// A triangle, uniform over its area.
     Triangle(TriangleLight),
+    /// A point light, or a spot (a point light with a cone).
+    Point(PointLight),
+    /// Light from one direction.
+    Directional(DirectionalLight),
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -52,10 +57,44 @@ struct TriangleLight {
     radiance: Rgb,
 }
 
+/// A spot's cone (a point light's takes every direction: cos_cone −∞).
+#[derive(Clone, Copy, Debug)]
+struct PointLight {
+    position: Vec3,
+    intensity: Rgb,
+    /// The attenuation's a, b, c: 1/(a·d² + b·d + c).
+    attenuation: [f32; 3],
+    axis: Vec3,
+    cos_cone: f32,
+    exponent: f32,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct DirectionalLight {
+    direction: Vec3,
+    irradiance: Rgb,
+}
+
 impl LaneLight {
     /// The light the lanes draw for `light`, if they draw it.
     fn new(light: &LightSource) -> Option<Self> {
-        let LightSource::Area { radiance, emitter, .. } = *light else { return None };
+        let point = |position, intensity, attenuation: Attenuation, axis, cos_cone, exponent| {
+            let attenuation = [attenuation.a, attenuation.b, attenuation.c];
+            Some(LaneLight::Point(PointLight { position, intensity, attenuation, axis, cos_cone, exponent }))
+        };
+        let (radiance, emitter) = match *light {
+            LightSource::Area { radiance, emitter, .. } => (radiance, emitter),
+            LightSource::Point { position, intensity, attenuation } => {
+                return point(position, intensity, attenuation, Vec3::Z, f32::NEG_INFINITY, 0.0);
+            }
+            LightSource::Spot { position, direction, cos_cone, exponent, intensity, attenuation } => {
+                return point(position, intensity, attenuation, direction, cos_cone, exponent);
+            }
+            LightSource::Directional { direction, irradiance } => {
+                return Some(LaneLight::Directional(DirectionalLight { direction, irradiance }));
+            }
+            LightSource::Background { .. } => return None,
+        };
         let error = emitter.error();
         Some(match emitter {
             Emitter::Sphere { center, radius, cap, .. } if cap.is_whole() => {
@@ -100,6 +139,20 @@ impl LaneLight {
             _ => None,
         }
     }
+
+    fn point(&self) -> Option<&PointLight> {
+        match self {
+            LaneLight::Point(point) => Some(point),
+            _ => None,
+        }
+    }
+
+    fn directional(&self) -> Option<&DirectionalLight> {
+        match self {
+            LaneLight::Directional(directional) => Some(directional),
+            _ => None,
+        }
+    }
 }
 
 /// The scene's lights as the lanes sample them, with what every sample
@@ -113,7 +166,7 @@ pub(super) struct LaneLights {
     one_kind: bool,
     /// Of each kind, the index of the first light and whether it is the
     /// only one (then it is splat rather than gathered lane by lane).
-    first: [Option<(usize, bool)>; 3],
+    first: [Option<(usize, bool)>; 5],
 }
 
 impl LaneLights {
@@ -128,6 +181,8 @@ impl LaneLights {
             first(|light| light.cap().is_some()),
             first(|light| light.sphere().is_some()),
             first(|light| light.triangle().is_some()),
+            first(|light| light.point().is_some()),
+            first(|light| light.directional().is_some()),
         ];
         LaneLights {
             one_kind: lights.iter().all(Option::is_some) && first.iter().flatten().count() == 1,
@@ -295,8 +350,20 @@ pub(super) struct LightLanes {
 }
 
 impl LightLanes {
-    /// `LightSource::sample` for each lane's light: area lights in lanes,
-    /// other lights through the scalar code.
+    /// A delta light's samples in the lanes of `lanes`, `valid` those it lights.
+    #[inline(always)]
+    fn set(&mut self, lanes: M8, valid: M8, wi: V8, value: V8, origin: V8, t_max: F8) {
+        self.valid = lanes.select_mask(valid, self.valid);
+        self.delta = self.delta.or(lanes);
+        self.wi = lanes.select_v(wi, self.wi);
+        self.value = lanes.select_v(value, self.value);
+        self.pdf = lanes.select(F8::splat(f32::INFINITY), self.pdf);
+        self.origin = lanes.select_v(origin, self.origin);
+        self.t_max = lanes.select(t_max, self.t_max);
+    }
+
+    /// `LightSource::sample` for each lane's light: all but the background
+    /// in the lanes.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(super) fn sample(
@@ -339,6 +406,31 @@ impl LightLanes {
             let faces = !light_normal.dot(-wi).le(F8::splat(0.0));
             let valid = in_lanes.and(pdf.gt(F8::splat(0.0))).and(faces);
             out = LightLanes { valid, delta: M8::NONE, wi, value: radiance / pdf, pdf, origin, t_max };
+        }
+        if let Some((lanes, points)) = lights.of_kind(pick, mask, 3, LaneLight::point) {
+            let position = points.v8(|light| light.position);
+            let (origin, wi, t_max) = ray_to(point, error, normal, position, F8::splat(0.0));
+            let distance = (position - point).length();
+            let coefficient = |k: usize| points.f8(|light| light.attenuation[k]);
+            let (a, b, c) = (coefficient(0), coefficient(1), coefficient(2));
+            let attenuation = F8::splat(1.0) / (a * distance * distance + b * distance + c);
+            // The spot's factor (`spot_factor`): 0 outside the cone, where
+            // the light gives no sample
+            let cos = points.v8(|light| light.axis).dot(-wi);
+            let exponent = points.f8(|light| light.exponent);
+            let inside = exponent.eq(F8::splat(0.0)).select(F8::splat(1.0), cos.powf(exponent));
+            let spot = cos.lt(points.f8(|light| light.cos_cone)).select(F8::splat(0.0), inside);
+            let value = points.v8(|light| light.intensity) * (attenuation * spot);
+            let valid = lanes.and_not(spot.eq(F8::splat(0.0)));
+            out.set(lanes, valid, wi, value, origin, t_max);
+            in_lanes = in_lanes.or(lanes);
+        }
+        if let Some((lanes, directionals)) = lights.of_kind(pick, mask, 4, LaneLight::directional) {
+            let wi = -directionals.v8(|light| light.direction);
+            let origin = offset_origin(point, error, normal, wi);
+            let value = directionals.v8(|light| light.irradiance);
+            out.set(lanes, lanes, wi, value, origin, F8::splat(f32::INFINITY));
+            in_lanes = in_lanes.or(lanes);
         }
         let others = mask.and_not(in_lanes);
         for lane in (0..LANES).filter(|&i| others.test(i)) {

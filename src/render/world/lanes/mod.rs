@@ -198,7 +198,9 @@ impl Real for F8 {
     #[inline(always)]
     fn powf(self, exponent: F8) -> F8 {
         let (x, e) = (self.to_array(), exponent.to_array());
-        F8::from_array(each(|i| x[i].powf(e[i])))
+        // x⁰ is 1 for every x (NaN too, as libm has it): lanes that do not
+        // use the power (a point light's, a Lambert surface's) skip the call
+        F8::from_array(each(|i| if e[i] == 0.0 { 1.0 } else { x[i].powf(e[i]) }))
     }
     #[inline(always)]
     fn select(mask: M8, a: F8, b: F8) -> F8 {
@@ -317,6 +319,24 @@ mod tests {
                         (u.x.to_bits(), u.y.to_bits())
                     );
                 }
+            }
+        }
+    }
+
+    /// `Real::powf` in the lanes is libm's `powf` lane by lane, the lanes
+    /// that skip the call (exponent 0) included: NaN, zeros, negatives,
+    /// infinities and subnormals as bases.
+    #[test]
+    fn powers_are_libms() {
+        let bases = [f32::NAN, 0.0, -0.0, -2.5, 0.3, 1.0, f32::INFINITY, 1e-40];
+        let exponents = [0.0, -0.0, 1.0, 0.5, 40.0, -3.0, 2.0, f32::NAN];
+        for rotation in 0..LANES {
+            let x = F8::from_fn(|i| bases[(i + rotation) % LANES]);
+            let e = F8::from_array(exponents);
+            let got = Real::powf(x, e).to_array();
+            for i in 0..LANES {
+                let expected = x.lane(i).powf(exponents[i]);
+                assert_eq!(got[i].to_bits(), expected.to_bits(), "{}^{}", x.lane(i), exponents[i]);
             }
         }
     }
