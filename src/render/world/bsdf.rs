@@ -11,7 +11,7 @@ use crate::geometry::real::{Real, V3};
 use crate::geometry::Frame;
 use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::{
-    cosine_hemisphere, cosine_hemisphere_pdf, cosine_hemisphere_pdf_of, power_cosine, power_cosine_pdf_of,
+    cosine_hemisphere, cosine_hemisphere_pdf, cosine_hemisphere_pdf_of, power_cosine,
 };
 use crate::scene::{MaterialModel, Rgb};
 
@@ -127,47 +127,60 @@ pub enum Bsdf {
     Black,
 }
 
-/// Phong's f (the thesis' lobe, normalised): diffuse plus (n + 2)/2π ·
-/// cosⁿ α about the mirror direction, for directions above the surface.
+/// A glossy lobe's f and the pdf of its sampling, from one power: the
+/// lobe's cosine `cos` (to the mirror direction for Phong, of the half
+/// vector for Blinn–Phong) raised to `exponent`; the lobe is scaled by
+/// `lobe_scale`, the lobe's pdf divided by `pdf_divisor`, and the diffuse
+/// part taken with probability `pd`.
 #[inline(always)]
-pub fn phong_of<R: Real>(kd: V3<R>, ks: V3<R>, exponent: R, wo: V3<R>, wi: V3<R>, n: V3<R>) -> V3<R> {
-    let cos_alpha = reflect_of(wo, n).dot(wi).max(R::splat(0.0));
-    let lobe = ks * ((exponent + 2.0) * 0.5 * FRAC_1_PI * cos_alpha.powf(exponent));
-    let lobe = if faults::active(Fault::PhongLobeDim) { lobe * R::splat(0.97) } else { lobe };
-    kd * R::splat(FRAC_1_PI) + lobe
+#[allow(clippy::too_many_arguments)]
+fn glossy_of<R: Real>(
+    kd: V3<R>,
+    ks: V3<R>,
+    exponent: R,
+    cos: R,
+    lobe_scale: R,
+    pdf_divisor: R,
+    pd: R,
+    cos_wi: R,
+) -> (V3<R>, R) {
+    let zero = R::splat(0.0);
+    let power = cos.max(zero).powf(exponent);
+    let lobe = ks * (lobe_scale * power);
+    let specular = R::select(cos.le(zero), zero, (exponent + 1.0) * 0.5 * FRAC_1_PI * power) / pdf_divisor;
+    (kd * R::splat(FRAC_1_PI) + lobe, pd * cosine_hemisphere_pdf_of(cos_wi) + (R::splat(1.0) - pd) * specular)
 }
 
-/// Blinn–Phong's f: diffuse plus cosⁿ of the half vector, normalised by
-/// `normalisation` (`blinn_normalisation` of the exponent).
+/// Phong's f (the thesis' lobe, normalised: diffuse plus (n + 2)/2π · cosⁿ α
+/// about the mirror direction) and the pdf of its sampling (the diffuse
+/// lobe with probability `pd`, else cosⁿ α), for directions above the
+/// surface.
 #[inline(always)]
+pub fn phong_of<R: Real>(kd: V3<R>, ks: V3<R>, exponent: R, pd: R, wo: V3<R>, wi: V3<R>, n: V3<R>) -> (V3<R>, R) {
+    let cos_alpha = reflect_of(wo, n).dot(wi);
+    let lobe_scale = (exponent + 2.0) * 0.5 * FRAC_1_PI;
+    let lobe_scale = if faults::active(Fault::PhongLobeDim) { lobe_scale * 0.97 } else { lobe_scale };
+    glossy_of(kd, ks, exponent, cos_alpha, lobe_scale, R::splat(1.0), pd, wi.dot(n))
+}
+
+/// Blinn–Phong's f (diffuse plus cosⁿ of the half vector, normalised by
+/// `normalisation`, `blinn_normalisation` of the exponent) and the pdf of
+/// its sampling (a half vector cosⁿ about the normal, turned into wi's
+/// density), for directions above the surface.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub fn blinn_phong_of<R: Real>(
     kd: V3<R>,
     ks: V3<R>,
     exponent: R,
     normalisation: R,
+    pd: R,
     wo: V3<R>,
     wi: V3<R>,
     n: V3<R>,
-) -> V3<R> {
+) -> (V3<R>, R) {
     let h = (wo + wi).normalize();
-    kd * R::splat(FRAC_1_PI) + ks * (normalisation * n.dot(h).max(R::splat(0.0)).powf(exponent))
-}
-
-/// The pdf of Phong's sampling: the diffuse lobe with probability `pd`,
-/// else cosⁿ about the mirror direction.
-#[inline(always)]
-pub fn phong_pdf_of<R: Real>(pd: R, exponent: R, wo: V3<R>, wi: V3<R>, n: V3<R>) -> R {
-    let specular = power_cosine_pdf_of(reflect_of(wo, n).dot(wi), exponent);
-    pd * cosine_hemisphere_pdf_of(wi.dot(n)) + (R::splat(1.0) - pd) * specular
-}
-
-/// The pdf of Blinn–Phong's sampling: the diffuse lobe with probability
-/// `pd`, else a half vector cosⁿ about the normal, turned into wi's density.
-#[inline(always)]
-pub fn blinn_phong_pdf_of<R: Real>(pd: R, exponent: R, wo: V3<R>, wi: V3<R>, n: V3<R>) -> R {
-    let h = (wo + wi).normalize();
-    let specular = power_cosine_pdf_of(n.dot(h), exponent) / (wo.dot(h) * 4.0);
-    pd * cosine_hemisphere_pdf_of(wi.dot(n)) + (R::splat(1.0) - pd) * specular
+    glossy_of(kd, ks, exponent, n.dot(h), normalisation, wo.dot(h) * 4.0, pd, wi.dot(n))
 }
 
 impl Bsdf {
@@ -218,38 +231,34 @@ impl Bsdf {
     /// f(wo, wi) for the non-delta part; `n` faces `wo`'s side.
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3, n: Vec3) -> Rgb {
-        if wi.dot(n) <= 0.0 || wo.dot(n) <= 0.0 {
-            return Rgb::ZERO;
-        }
-        match *self {
-            Bsdf::Lambert { albedo } => albedo * FRAC_1_PI,
-            Bsdf::Phong { kd, ks, exponent } => {
-                phong_of(kd.into(), ks.into(), exponent, wo.into(), wi.into(), n.into()).into()
-            }
-            Bsdf::BlinnPhong { kd, ks, exponent } => {
-                let normalisation = blinn_normalisation(exponent);
-                blinn_phong_of(kd.into(), ks.into(), exponent, normalisation, wo.into(), wi.into(), n.into()).into()
-            }
-            Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::Black => Rgb::ZERO,
-        }
+        self.eval_pdf(wo, wi, n).0
     }
 
     /// Solid-angle pdf of `sample` choosing `wi`.
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3, n: Vec3) -> f32 {
+        self.eval_pdf(wo, wi, n).1
+    }
+
+    /// `eval` and `pdf` together: a glossy lobe's power serves both.
+    #[inline]
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3, n: Vec3) -> (Rgb, f32) {
         if wi.dot(n) <= 0.0 || wo.dot(n) <= 0.0 {
-            return 0.0;
+            return (Rgb::ZERO, 0.0);
         }
-        match *self {
-            Bsdf::Lambert { .. } => cosine_hemisphere_pdf_of(wi.dot(n)),
+        let (wo, wi, n) = (wo.into(), wi.into(), n.into());
+        let (f, pdf) = match *self {
+            Bsdf::Lambert { albedo } => return (albedo * FRAC_1_PI, cosine_hemisphere_pdf_of(V3::dot(wi, n))),
             Bsdf::Phong { kd, ks, exponent } => {
-                phong_pdf_of(Self::diffuse_probability(kd, ks), exponent, wo.into(), wi.into(), n.into())
+                phong_of(kd.into(), ks.into(), exponent, Self::diffuse_probability(kd, ks), wo, wi, n)
             }
             Bsdf::BlinnPhong { kd, ks, exponent } => {
-                blinn_phong_pdf_of(Self::diffuse_probability(kd, ks), exponent, wo.into(), wi.into(), n.into())
+                let (normalisation, pd) = (blinn_normalisation(exponent), Self::diffuse_probability(kd, ks));
+                blinn_phong_of(kd.into(), ks.into(), exponent, normalisation, pd, wo, wi, n)
             }
-            Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::Black => 0.0,
-        }
+            Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::Black => return (Rgb::ZERO, 0.0),
+        };
+        (f.into(), pdf)
     }
 
     /// Draw an incoming direction. `n` is the geometric normal (any side);
@@ -260,11 +269,11 @@ impl Bsdf {
     pub fn sample(&self, wo: Vec3, n: Vec3, sampler: &mut Sampler, transport: Transport) -> Option<BsdfSample> {
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
         let scattered = |wi: Vec3| -> Option<BsdfSample> {
-            let pdf = self.pdf(wo, wi, facing);
+            let (f, pdf) = self.eval_pdf(wo, wi, facing);
             if pdf <= 0.0 {
                 return None;
             }
-            let weight = self.eval(wo, wi, facing) * (wi.dot(facing) / pdf);
+            let weight = f * (wi.dot(facing) / pdf);
             Some(BsdfSample { wi, weight, pdf, delta: false })
         };
         match *self {

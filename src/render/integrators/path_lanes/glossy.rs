@@ -6,7 +6,7 @@ use glam::Vec3;
 
 use super::{Surface, BLINN_PHONG, PHONG};
 use crate::geometry::{frame_from_z, to_world};
-use crate::render::world::bsdf::{blinn_phong_of, blinn_phong_pdf_of, phong_of, phong_pdf_of, reflect_of};
+use crate::render::world::bsdf::{blinn_phong_of, phong_of, reflect_of};
 use crate::render::world::lanes::{F8, LANES, M8, V8};
 use crate::render::world::sampling::{cosine_hemisphere_of, power_cosine_of};
 
@@ -41,32 +41,21 @@ impl GlossyLanes {
         self.phong.or(self.blinn_phong)
     }
 
-    /// `Bsdf::eval` for `wo` and `wi` above the surface of normal `n`.
+    /// `Bsdf::eval_pdf` for `wo` and `wi` above the surface of normal `n`.
     #[inline(always)]
-    pub(super) fn f(&self, wo: V8, wi: V8, n: V8) -> V8 {
-        let mut f = V8::splat(Vec3::ZERO);
+    pub(super) fn f_pdf(&self, wo: V8, wi: V8, n: V8) -> (V8, F8) {
+        let (mut f, mut pdf) = (V8::splat(Vec3::ZERO), F8::splat(0.0));
+        let pd = self.diffuse_probability;
         if self.phong.any() {
-            f = self.phong.select_v(phong_of(self.kd, self.ks, self.exponent, wo, wi, n), f);
+            let (phong_f, phong_pdf) = phong_of(self.kd, self.ks, self.exponent, pd, wo, wi, n);
+            (f, pdf) = (self.phong.select_v(phong_f, f), self.phong.select(phong_pdf, pdf));
         }
         if self.blinn_phong.any() {
-            let blinn_phong = blinn_phong_of(self.kd, self.ks, self.exponent, self.normalisation, wo, wi, n);
-            f = self.blinn_phong.select_v(blinn_phong, f);
+            let (blinn_f, blinn_pdf) =
+                blinn_phong_of(self.kd, self.ks, self.exponent, self.normalisation, pd, wo, wi, n);
+            (f, pdf) = (self.blinn_phong.select_v(blinn_f, f), self.blinn_phong.select(blinn_pdf, pdf));
         }
-        f
-    }
-
-    /// `Bsdf::pdf` for `wo` and `wi` above the surface of normal `n`.
-    #[inline(always)]
-    pub(super) fn pdf(&self, wo: V8, wi: V8, n: V8) -> F8 {
-        let mut pdf = F8::splat(0.0);
-        if self.phong.any() {
-            pdf = self.phong.select(phong_pdf_of(self.diffuse_probability, self.exponent, wo, wi, n), pdf);
-        }
-        if self.blinn_phong.any() {
-            let blinn_phong = blinn_phong_pdf_of(self.diffuse_probability, self.exponent, wo, wi, n);
-            pdf = self.blinn_phong.select(blinn_phong, pdf);
-        }
-        pdf
+        (f, pdf)
     }
 
     /// `Bsdf::sample` from the lobe draw `u_lobe` and the direction draw
@@ -83,9 +72,10 @@ impl GlossyLanes {
         let wi = u_lobe.lt(self.diffuse_probability).select_v(diffuse, specular);
         // The pdf is 0 below the surface, and a direction of pdf 0 ends the path
         let below = wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
-        let pdf = below.select(zero, self.pdf(wo, wi, facing));
+        let (f, pdf) = self.f_pdf(wo, wi, facing);
+        let pdf = below.select(zero, pdf);
         let scattered = self.mask().and_not(pdf.le(zero));
-        let weight = self.f(wo, wi, facing) * (wi.dot(facing) / pdf);
+        let weight = f * (wi.dot(facing) / pdf);
         (scattered, wi, weight, pdf)
     }
 }

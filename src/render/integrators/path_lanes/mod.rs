@@ -1,17 +1,15 @@
-//! Path tracing eight paths at a time: each sphere and plane is tested
-//! against eight rays in one SIMD pass, triangles lane by lane (behind their
-//! bounding balls), and the shading runs in the same lanes. A lane whose
-//! path ends takes the next sample, so lanes stay busy however long the
-//! paths are.
+//! Path tracing eight paths at a time: each sphere, plane and triangle is
+//! tested against eight rays in one SIMD pass (a triangle behind an
+//! eight-ray test of its bounding ball), and the shading, the BSDFs and
+//! light sampling run in the same lanes. A lane whose path ends takes the
+//! next sample, so lanes stay busy however long the paths are.
 //!
 //! It is `path::radiance` lane by lane, not an approximation of it: the
 //! same operations in the same order on the same random streams, so the
 //! image is bit for bit the scalar one (`tests/path_lanes.rs` checks it).
-//! Rare cases (a BSDF-sampled ray reaching a light, lights other than a
-//! sphere's cap or a triangle) and the watertight triangle test call the
-//! scalar code for that lane. Scenes with
-//! other materials than Lambert, mirror, glass and emitters, or with the
-//! background as a light, are traced by the scalar code.
+//! Rare cases call the scalar code for that lane: a BSDF-sampled ray
+//! reaching a light, the background sampled as a light, a ray exactly on a
+//! triangle's edge.
 
 use std::f32::consts::FRAC_1_PI;
 
@@ -43,8 +41,7 @@ use crate::scene::{MaterialModel, Rgb};
 const ROULETTE_DEPTH: u32 = crate::render::integrators::path::ROULETTE_DEPTH;
 
 /// The `Bsdf` each shape's lanes run, as a float to compare eight at a
-/// time (the lanes run these four; a scene with another model is traced by
-/// the scalar code).
+/// time.
 const LAMBERT: f32 = 0.0;
 const MIRROR: f32 = 1.0;
 const GLASS: f32 = 2.0;
@@ -202,7 +199,7 @@ impl PathLanes {
                 _ => None,
             })
             .collect();
-        // The sphere each light lies on, and the cap the lanes sample of it
+        // The sphere each light lies on
         let light_spheres: Vec<Option<u32>> = (world.lights.iter())
             .map(|light| match *light {
                 LightSource::Area { object, .. } => match world.objects[object as usize].shape {
@@ -486,8 +483,11 @@ impl PathLanes {
             // f (Lambert's albedo / π) where both directions are above the surface
             let above = !light.wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
             let mut f = color * F8::splat(FRAC_1_PI);
+            let mut glossy_pdf = None;
             if glossy.mask().and(light.valid).and(above).any() {
-                f = glossy.mask().select_v(glossy.f(wo, light.wi, facing), f);
+                let (glossy_f, pdf) = glossy.f_pdf(wo, light.wi, facing);
+                f = glossy.mask().select_v(glossy_f, f);
+                glossy_pdf = Some(pdf);
             }
             let shade = light.valid.and(above).and(f.nonzero());
             counters.rays += shade.count();
@@ -497,8 +497,8 @@ impl PathLanes {
                 if lit.any() {
                     let cos = light.wi.dot(facing);
                     let mut bsdf_pdf = cos.max(zero) * FRAC_1_PI;
-                    if glossy.mask().and(lit).any() {
-                        bsdf_pdf = glossy.mask().select(glossy.pdf(wo, light.wi, facing), bsdf_pdf);
+                    if let Some(pdf) = glossy_pdf {
+                        bsdf_pdf = glossy.mask().select(pdf, bsdf_pdf);
                     }
                     let mis = power_heuristic_of(pick_pdf * light.pdf, bsdf_pdf);
                     let weight = light.delta.select(F8::splat(1.0), mis);
@@ -698,7 +698,7 @@ impl PathLanes {
                 blocked = blocked.or(if plane.wall.is_some() { outside.and(hits) } else { hits });
             }
         }
-        // Triangles lane by lane where the ray may reach them, but those in
+        // Triangles where the ray may reach them, but those in
         // the plane of the light's own triangle (`Occluders::blocks`)
         for (j, (triangle, plane)) in self.triangles.iter().zip(&self.triangle_planes).enumerate() {
             let near = self.may_reach(j, mask.and_not(blocked), origin, direction, t_max);
