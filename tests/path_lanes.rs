@@ -118,6 +118,21 @@ fn other_lights_bit_for_bit() {
     glow.name = "glow".into();
     glow.shape = gi_studio::scene::Shape::Sphere { center: Vec3::new(60.0, 40.0, 100.0), radius: 4.0 };
     scene.objects.push(glow);
+    // A second of each kind of area light, so each kind is gathered lane by
+    // lane: another ball, another light through the ceiling (a cap)
+    let mut glow = scene.objects[8].clone();
+    glow.name = "second glow".into();
+    glow.shape = gi_studio::scene::Shape::Sphere { center: Vec3::new(35.0, 55.0, 120.0), radius: 3.0 };
+    scene.objects.push(glow);
+    let mut cap = scene.objects[8].clone();
+    cap.name = "second cap".into();
+    cap.shape = gi_studio::scene::Shape::Sphere { center: Vec3::new(25.0, 681.0, 120.0), radius: 600.0 };
+    scene.objects.push(cap);
+    let mut panel = scene.objects[8].clone();
+    panel.name = "second panel".into();
+    let (a, b, c) = (Vec3::new(60.0, 75.0, 110.0), Vec3::new(80.0, 75.0, 110.0), Vec3::new(70.0, 75.0, 130.0));
+    panel.shape = gi_studio::scene::Shape::Triangle { a, b, c };
+    scene.objects.push(panel);
     // And a glowing triangle facing down: caps, triangles and whole spheres
     // drawn in one batch of lanes
     let mut panel = scene.objects[8].clone();
