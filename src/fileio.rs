@@ -79,6 +79,14 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> io:
 }
 
 /// Write `bytes` to `path` atomically.
+/// The file beside `path` named as it is plus `suffix`: `x.exr` and
+/// `.meta.ron` give `x.exr.meta.ron` (a file's metadata, kept beside it).
+pub fn beside(path: &Path, suffix: &str) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_owned();
+    name.push(suffix);
+    path.with_file_name(name)
+}
+
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
     write_atomic(path, |out| out.write_all(bytes))
 }

@@ -10,7 +10,7 @@ use gi_studio::render::world::camera::CameraTile;
 use gi_studio::render::world::camera::TileRect;
 use gi_studio::render::world::rng::PassStreams;
 use gi_studio::render::world::World;
-use gi_studio::scene::{presets, Attenuation, Light, LightKind, MaterialModel, Rgb, Scene, ValidScene};
+use gi_studio::scene::{presets, Attenuation, Light, LightKind, MaterialModel, Object, Rgb, Scene, Shape, ValidScene};
 use glam::Vec3;
 
 fn light(kind: LightKind, intensity: f32) -> Light {
@@ -113,33 +113,26 @@ fn other_lights_bit_for_bit() {
     near.name = "near point".into();
     near.attenuation = Attenuation { a: 0.001, b: 0.05, c: 0.5 };
     scene.lights.push(near);
-    // A small glowing ball inside the room: sampled as a whole sphere
-    let mut glow = scene.objects[8].clone();
-    glow.name = "glow".into();
-    glow.shape = gi_studio::scene::Shape::Sphere { center: Vec3::new(60.0, 40.0, 100.0), radius: 4.0 };
-    scene.objects.push(glow);
+    // Emitters of smallpt's light's material (object 8)
+    let glowing = |scene: &mut Scene, name: &str, shape: Shape| {
+        scene.objects.push(Object { name: name.into(), shape, ..scene.objects[8].clone() });
+    };
+    let triangle = |a: [f32; 3], b: [f32; 3], c: [f32; 3]| Shape::Triangle {
+        a: Vec3::from(a),
+        b: Vec3::from(b),
+        c: Vec3::from(c),
+    };
+    // A small glowing ball inside the room (sampled as a whole sphere) and a
+    // glowing triangle facing down: caps, triangles and whole spheres drawn
+    // in one batch of lanes
+    glowing(&mut scene, "glow", Shape::Sphere { center: Vec3::new(60.0, 40.0, 100.0), radius: 4.0 });
+    glowing(&mut scene, "panel", triangle([20.0, 70.0, 60.0], [40.0, 70.0, 60.0], [30.0, 70.0, 80.0]));
     // A second of each kind of area light, so each kind is gathered lane by
-    // lane: another ball, another light through the ceiling (a cap)
-    let mut glow = scene.objects[8].clone();
-    glow.name = "second glow".into();
-    glow.shape = gi_studio::scene::Shape::Sphere { center: Vec3::new(35.0, 55.0, 120.0), radius: 3.0 };
-    scene.objects.push(glow);
-    let mut cap = scene.objects[8].clone();
-    cap.name = "second cap".into();
-    cap.shape = gi_studio::scene::Shape::Sphere { center: Vec3::new(25.0, 681.0, 120.0), radius: 600.0 };
-    scene.objects.push(cap);
-    let mut panel = scene.objects[8].clone();
-    panel.name = "second panel".into();
-    let (a, b, c) = (Vec3::new(60.0, 75.0, 110.0), Vec3::new(80.0, 75.0, 110.0), Vec3::new(70.0, 75.0, 130.0));
-    panel.shape = gi_studio::scene::Shape::Triangle { a, b, c };
-    scene.objects.push(panel);
-    // And a glowing triangle facing down: caps, triangles and whole spheres
-    // drawn in one batch of lanes
-    let mut panel = scene.objects[8].clone();
-    panel.name = "panel".into();
-    let (a, b, c) = (Vec3::new(20.0, 70.0, 60.0), Vec3::new(40.0, 70.0, 60.0), Vec3::new(30.0, 70.0, 80.0));
-    panel.shape = gi_studio::scene::Shape::Triangle { a, b, c };
-    scene.objects.push(panel);
+    // lane: another ball, another light through the ceiling (a cap), another
+    // triangle
+    glowing(&mut scene, "second glow", Shape::Sphere { center: Vec3::new(35.0, 55.0, 120.0), radius: 3.0 });
+    glowing(&mut scene, "second cap", Shape::Sphere { center: Vec3::new(25.0, 681.0, 120.0), radius: 600.0 });
+    glowing(&mut scene, "second panel", triangle([60.0, 75.0, 110.0], [80.0, 75.0, 110.0], [70.0, 75.0, 130.0]));
     assert_lanes_match_scalar(&scene, 32, 2);
     scene.lights.push(light(LightKind::Directional { direction: Vec3::new(0.1, -1.0, 0.3) }, 1.0));
     assert_lanes_match_scalar(&scene, 32, 1);

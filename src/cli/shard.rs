@@ -97,9 +97,7 @@ pub struct ShardManifest {
 
 /// `x.exr` → `x.exr.shard.ron`.
 pub fn manifest_path(part: &Path) -> PathBuf {
-    let mut name = part.file_name().unwrap_or_default().to_owned();
-    name.push(".shard.ron");
-    part.with_file_name(name)
+    crate::fileio::beside(part, ".shard.ron")
 }
 
 fn header() -> String {

@@ -28,9 +28,7 @@ const VARIANCE: &str = "variance";
 
 /// `x.exr` → `x.exr.meta.ron`.
 pub fn info_path(image: &Path) -> PathBuf {
-    let mut name = image.file_name().unwrap_or_default().to_owned();
-    name.push(".meta.ron");
-    image.with_file_name(name)
+    crate::fileio::beside(image, ".meta.ron")
 }
 
 /// The first line of every metadata file: what it is, and whose.

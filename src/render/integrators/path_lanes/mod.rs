@@ -653,7 +653,7 @@ impl PathLanes {
     }
 
     /// Lanes of `mask` whose ray may reach triangle `j` before `t_max`
-    /// (`intersect_triangle`'s first test, which it repeats).
+    /// (`intersect_triangle`'s first test).
     #[inline(always)]
     fn may_reach(&self, j: usize, mask: M8, origin: V8, direction: V8, t_max: F8) -> M8 {
         let (center, radius) = self.triangles[j].bound();
