@@ -174,7 +174,7 @@ pub struct BidirFlags {
     /// How strategies are weighed: power or balance (bdpt, bpm, vcm).
     #[arg(long)]
     pub mis: Option<MisHeuristic>,
-    /// Merge radius at the first pass (bpm, vcm; 0 = 2% of the scene's size).
+    /// Merge radius at the first pass (bpm, vcm; 0 = 2% of what the camera sees for bpm, 0.5% for vcm).
     #[arg(long, value_parser = |s: &str| limits::LENGTH.parse(s))]
     pub merge_radius: Option<f32>,
     /// Merge radius reduction α in (0, 1] (bpm, vcm).

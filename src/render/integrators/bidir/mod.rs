@@ -103,8 +103,14 @@ impl Context<'_> {
 }
 
 impl Bidir {
-    /// For `settings`' method (one of the four) on `world`; the merge
-    /// radius, when the settings leave it, is 2% of what the camera sees (as SPPM starts).
+    /// For `settings`' method (one of the four) on `world`. The merge
+    /// radius, when the settings leave it, is a share of what the camera
+    /// sees: 2% for BPM (as SPPM starts), whose merges carry every path;
+    /// 0.5% for VCM, whose connections carry most paths, so a wide radius
+    /// buys little noise and costs bias: light leaking through a thin wall
+    /// where a plane runs on past it (gap-room's partition lit its far
+    /// room's corners at 2%, 20 times too bright, and held VCM's error
+    /// above BDPT's at equal passes).
     pub fn new(world: &World, settings: &RenderSettings, visible_radius: f32) -> Self {
         let (mode, heuristic, radius, alpha) = match &settings.method {
             Method::Bdpt(b) => (Mode::Connect, b.mis, 0.0, 1.0),
@@ -112,7 +118,8 @@ impl Bidir {
             Method::Vcm(m) => (Mode::ConnectAndMerge, m.mis, m.radius, m.alpha),
             _ => (Mode::LightTracing, MisHeuristic::Power, 0.0, 1.0),
         };
-        let radius = if radius > 0.0 { radius } else { (visible_radius * 0.02).max(1e-6) };
+        let share = if mode == Mode::ConnectAndMerge { 0.005 } else { 0.02 };
+        let radius = if radius > 0.0 { radius } else { (visible_radius * share).max(1e-6) };
         Self {
             mode,
             heuristic,
