@@ -396,6 +396,24 @@ mod tests {
     use crate::render::world::rng::Sampler;
     use crate::render::world::World;
 
+    /// A light sphere sharing its centre with the sphere it is cut to lies
+    /// wholly inside a larger one and wholly outside a smaller one, with a
+    /// finite frame either way (no direction to the other centre to divide
+    /// by). Radii equal are the boundary, where either answer is the sphere
+    /// itself: left untested, as the cut's `<` is there.
+    #[test]
+    fn a_concentric_cut_is_all_or_nothing() {
+        let c = Vec3::new(1.0, -2.0, 3.0);
+        assert!(EmitterCap::inside(c, 0.5, c, 2.0).is_whole());
+        let none = EmitterCap::inside(c, 2.0, c, 0.5);
+        assert_eq!(none.one_minus_cos, 0.0);
+        assert!(none.frame.z.is_finite() && none.frame.x.is_finite());
+        // Off centre, the same formula from both sides: half of a unit
+        // sphere lies within √2 of a point at distance 1
+        let half = EmitterCap::inside(c, 1.0, c + Vec3::X, 2f32.sqrt());
+        assert!((half.one_minus_cos - 1.0).abs() < 1e-6 && (half.frame.z - Vec3::X).length() < 1e-6);
+    }
+
     /// smallpt's light is a sphere of radius 600 poking 0.27 through the
     /// ceiling. Light samples taken in the room land on the part under the
     /// ceiling and reach the light; sampling the light's part near the room
