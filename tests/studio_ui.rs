@@ -443,3 +443,26 @@ fn the_strategy_view_shows_each_strategy_with_its_share() {
     harness.run_steps(2);
     assert!(harness.query_by_label_contains("(s, t) = (1, 2): ").is_none(), "the view closed");
 }
+
+/// An SPPM pane's last pass is split into its stages under the photon
+/// plots: each stage named with its milliseconds.
+#[test]
+fn the_photon_plots_split_an_sppm_pass_into_its_stages() {
+    let mut harness = studio(1);
+    let pane = &mut harness.state_mut().panes_mut().list_mut()[0];
+    pane.settings_mut().method = gi_studio::render::Method::of(gi_studio::render::Algorithm::Sppm);
+    pane.settings_mut().set_photons(5_000);
+    harness.state_mut().restart_all();
+    step_until(&mut harness, |app| {
+        app.panes().list()[0].state().stats.as_ref().is_some_and(|s| s.photon.photons_traced > 0)
+    });
+    harness.run_steps(2);
+    let node = harness.get_by_label_contains("1: SPPM last pass: ");
+    let node = egui_kittest::kittest::NodeT::accesskit_node(&node);
+    let label = node.label().or_else(|| node.value()).unwrap_or_default();
+    for stage in ["eye pass", "photon tracing", "kd-tree", "gather"] {
+        let after = label.split(&format!("{stage} ")).nth(1).unwrap_or_else(|| panic!("no {stage} in {label}"));
+        let ms: Option<f64> = after.split_whitespace().next().and_then(|w| w.parse().ok());
+        assert!(ms.is_some_and(f64::is_finite) && after.contains(" ms"), "{label}");
+    }
+}

@@ -6,6 +6,7 @@ use egui_plot::{Bar, BarChart, HLine, Legend, Line, LineStyle, Plot};
 
 use super::pane::{Pane, PaneError};
 use crate::render::integrators::photon_map::maps::RADIUS_BINS;
+use crate::render::integrators::SppmTimes;
 
 pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
     // A fixed height: plots asking for all the space would push the panes out
@@ -136,6 +137,13 @@ fn photons_and_paths_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
     }
     for (i, pane) in panes.iter().enumerate() {
         let Some(stats) = &pane.state().stats else { continue };
+        if stats.photon.photons_traced > 0 {
+            any = true;
+            sppm_times_ui(ui, i, &stats.photon.times, height);
+        }
+    }
+    for (i, pane) in panes.iter().enumerate() {
+        let Some(stats) = &pane.state().stats else { continue };
         let p = &stats.paths;
         if p.light_paths > 0 {
             any = true;
@@ -154,4 +162,19 @@ fn photons_and_paths_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
     if !any {
         ui.weak("Statistics appear when a pane renders with photon mapping, SPPM or a bidirectional method.");
     }
+}
+
+/// Where pane `index`'s last SPPM pass spent its time: a line of figures
+/// and a bar a stage.
+fn sppm_times_ui(ui: &mut egui::Ui, index: usize, times: &SppmTimes, height: f32) {
+    let stages = times.stages();
+    let figures: Vec<String> =
+        stages.iter().map(|(stage, time)| format!("{stage} {:.0} ms", time.as_secs_f64() * 1e3)).collect();
+    ui.small(format!("{}: SPPM last pass: {}", index + 1, figures.join(" · ")));
+    Plot::new(("sppm_times", index)).legend(Legend::default()).height(height * 0.5).show(ui, |plot| {
+        for (x, (stage, time)) in stages.iter().enumerate() {
+            let bar = Bar::new(x as f64, time.as_secs_f64() * 1e3).width(0.8);
+            plot.bar_chart(BarChart::new(*stage, vec![bar]));
+        }
+    });
 }

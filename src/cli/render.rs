@@ -199,12 +199,22 @@ pub fn print_photon_statistics(outcome: &RenderOutcome) {
             .collect();
         let photon = &outcome.stats.photon;
         println!(
-            "SPPM mean radius per pass [{}]; last pass traced {} photons ({} stored) in {:.0} ms",
+            "SPPM mean radius per pass [{}]; last pass traced {} photons ({} stored)",
             shown.join(", "),
             photon.photons_traced,
             photon.photons_stored,
-            photon.trace_time.as_secs_f64() * 1e3
         );
+        let stages: Vec<String> = photon
+            .times
+            .stages()
+            .iter()
+            .map(|(stage, time)| {
+                // Three decimals for short stages (a small render's are microseconds)
+                let ms = time.as_secs_f64() * 1e3;
+                format!("{stage} {ms:.*} ms", if ms < 10.0 { 3 } else { 0 })
+            })
+            .collect();
+        println!("SPPM last pass: {}", stages.join(", "));
     }
 }
 

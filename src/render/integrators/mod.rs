@@ -57,12 +57,33 @@ impl Counters {
 pub struct PhotonPassStats {
     /// k-NN queries made while rendering the pass.
     pub queries: QueryStats,
-    /// SPPM: photons traced and stored this pass, and the time it took.
+    /// SPPM: photons traced and stored this pass, and where its time went.
     pub photons_traced: u64,
     pub photons_stored: u64,
-    pub trace_time: Duration,
+    pub times: SppmTimes,
     /// SPPM: mean gather radius over pixels after the pass.
     pub mean_radius: f32,
+}
+
+/// Where an SPPM pass's time went, stage by stage (wall-clock, each stage
+/// on every worker).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SppmTimes {
+    /// Camera rays to each pixel's visible point, with its direct light.
+    pub eye: Duration,
+    /// Emitting and tracing the pass's photons.
+    pub trace: Duration,
+    /// The kd-tree over the stored photons.
+    pub build: Duration,
+    /// Every visible point's photons gathered, its radius and flux updated.
+    pub gather: Duration,
+}
+
+impl SppmTimes {
+    /// The stages, named, in the order a pass runs them.
+    pub fn stages(&self) -> [(&'static str, Duration); 4] {
+        [("eye pass", self.eye), ("photon tracing", self.trace), ("kd-tree", self.build), ("gather", self.gather)]
+    }
 }
 
 /// What one pass did.

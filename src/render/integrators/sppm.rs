@@ -77,6 +77,7 @@ impl Sppm {
         let initial_radius = self.initial_radius;
         let max_depth = self.max_depth;
         let mut report = PassReport::default();
+        let eye_start = Instant::now();
         let per_tile: Vec<Counters> = (film.tiles.par_iter())
             .zip(self.pixels.par_iter_mut())
             .with_max_len(1)
@@ -104,18 +105,23 @@ impl Sppm {
         for counters in &per_tile {
             report.counters.add(counters);
         }
+        let times = &mut report.photon.times;
+        times.eye = eye_start.elapsed();
         let trace_start = Instant::now();
         let count = self.photons_per_pass;
         let keep_going = || observer.is_current();
         let (world, seed) = (stage.world, self.seed);
         let photons = trace_photons_until(world, MapKind::Indirect, count, pass as u64, seed, max_depth, &keep_going)?;
+        times.trace = trace_start.elapsed();
         report.photon.photons_traced = count;
         report.photon.photons_stored = photons.len() as u64;
+        let build_start = Instant::now();
         let tree = PhotonKdTree::build(photons);
-        report.photon.trace_time = trace_start.elapsed();
+        report.photon.times.build = build_start.elapsed();
         if !observer.is_current() {
             return None;
         }
+        let gather_start = Instant::now();
         let alpha = self.alpha;
         let radii: Vec<(f64, usize)> = (film.tiles.par_iter_mut())
             .zip(self.pixels.par_iter_mut())
@@ -141,6 +147,7 @@ impl Sppm {
         if !observer.is_current() {
             return None;
         }
+        report.photon.times.gather = gather_start.elapsed();
         let (sum, count) = radii.iter().fold((0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
         report.photon.mean_radius = (sum / count.max(1) as f64) as f32;
         Some(report)
