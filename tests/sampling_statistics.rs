@@ -286,3 +286,32 @@ fn photons_leave_each_light_with_its_intensity() {
         assert!(total.abs() < 4.0, "{name} light's photons carry {total:.1} standard errors too much power");
     }
 }
+
+/// The light picker over nothing to pick, and past its lights: a scene
+/// with no light, or with only a dark one, has nothing to emit (no photon,
+/// no light path, never a division by its zero power); two lights are
+/// picked in proportion to their power, and an index past them never is.
+#[test]
+fn the_light_picker_picks_by_power_and_never_from_nothing() {
+    use gi_studio::render::integrators::photon_map::emit::LightPicker;
+    let floor = || vec![object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor")];
+    let lit = |lights| {
+        let scene =
+            scene(camera(Vec3::new(0.0, 1.0, 6.0), Vec3::ZERO), vec![material("floor", lambert(0.5))], floor(), lights);
+        LightPicker::new(&World::new(&valid(scene)))
+    };
+    let point = |name: &str, x: f32, intensity| {
+        light(name, gi_studio::scene::LightKind::Point { position: Vec3::new(x, 1.0, 0.0) }, intensity)
+    };
+    for (what, picker) in [("no light", lit(vec![])), ("a dark light", lit(vec![point("dark", 0.0, 0.0)]))] {
+        assert!(picker.is_empty(), "{what}: something to pick");
+        assert_eq!(picker.pick(0.5), None, "{what}");
+        assert_eq!(picker.probability(0), 0.0, "{what}");
+    }
+    let two = lit(vec![point("dim", -1.0, 1.0), point("bright", 1.0, 3.0)]);
+    assert!(!two.is_empty());
+    assert!((two.probability(0) - 0.25).abs() < 1e-6 && (two.probability(1) - 0.75).abs() < 1e-6);
+    assert_eq!(two.probability(2), 0.0, "a light past the last");
+    assert_eq!(two.pick(0.1).map(|(i, _)| i), Some(0));
+    assert_eq!(two.pick(0.9).map(|(i, _)| i), Some(1));
+}
