@@ -19,15 +19,18 @@ pub enum Fault {
     RouletteUndivided,
     /// Photons carry 5% more power than their lights emit.
     PhotonPowerHigh,
+    /// A bug that panics while a job is prepared, on a render worker.
+    RenderPanics,
 }
 
 impl Fault {
-    pub const ALL: [Fault; 5] = [
+    pub const ALL: [Fault; 6] = [
         Fault::PhongLobeDim,
         Fault::SppmRadiusFixed,
         Fault::LightPdfOff,
         Fault::RouletteUndivided,
         Fault::PhotonPowerHigh,
+        Fault::RenderPanics,
     ];
 }
 

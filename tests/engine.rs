@@ -294,3 +294,11 @@ fn a_cancel_waits_for_at_most_one_tile_or_chunk_a_worker() {
     assert!(stopped.is_none(), "an abandoned trace gives no map");
     assert_eq!(traced.load(Ordering::SeqCst), 5, "only the chunks told to go on were traced");
 }
+
+/// A session renders one job after another to its end (the detector
+/// `tests/injected_bugs.rs` shows failing, not hanging, when a render
+/// worker panics).
+#[test]
+fn renders_end_and_the_session_serves_the_next() {
+    common::detectors::renders_end_and_sessions_go_on().expect("both renders finish");
+}

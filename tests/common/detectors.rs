@@ -311,3 +311,26 @@ pub fn path_tracing_agrees_with_its_reference(name: &str) -> Result<(), String> 
         Err(format!("{name}: worst |t| {:.1} ≥ {critical:.1} at {}", worst.0, worst.1))
     }
 }
+
+/// A render ends, with its image or with an error, and its session serves
+/// the next: a bug that panics on a render worker fails its job (it used
+/// to leave `render_blocking` waiting for ever, the session holding a
+/// sender of its own). Fires (Err) when a render fails; quiet on the right
+/// code, where both renders finish.
+pub fn renders_end_and_sessions_go_on() -> Result<(), String> {
+    let scene = std::sync::Arc::new(valid(presets::preset("cornell").and_then(Result::ok).expect("cornell")));
+    let job = RenderJob::new(scene, settings(Algorithm::Path, 8, 6, 1));
+    let workers = Workers::shared().ok_or("no workers")?;
+    let session = RenderSession::new(workers, None).map_err(|e| e.to_string())?;
+    for _ in 0..2 {
+        let generation = session.start(job.clone());
+        loop {
+            match session.events().recv().map_err(|e| e.to_string())? {
+                RenderEvent::Finished { generation: g, .. } if g == generation => break,
+                RenderEvent::Failed { generation: g, message } if g == generation => return Err(message),
+                _ => {}
+            }
+        }
+    }
+    Ok(())
+}

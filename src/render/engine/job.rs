@@ -12,6 +12,7 @@ use rayon::prelude::*;
 
 use super::events::{Notify, PassStats, RenderEvent, TileUpdate};
 use super::workers::Workers;
+use crate::faults::{self, Fault};
 use crate::render::film::Film;
 use crate::render::integrators::bidir::strategies::StrategyImages;
 use crate::render::integrators::photon_map::PhotonMaps;
@@ -71,7 +72,7 @@ pub(super) struct JobContext<'a> {
 }
 
 impl JobContext<'_> {
-    fn send(&self, event: RenderEvent) {
+    pub(super) fn send(&self, event: RenderEvent) {
         // The receiver is gone only when the session was dropped, and then
         // nobody is left to tell
         let news = event.is_news();
@@ -133,7 +134,10 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
     let start = Instant::now();
     let halves = settings.algorithm().is_unbiased();
     let mut film = Film::new(settings.width, settings.height, settings.tile_size, halves);
-    let prepared = workers.run(|| Integrator::prepare(&stage, &film, visible_radius, job.photon_maps.clone(), context));
+    let prepared = workers.run(|| {
+        assert!(!faults::active(Fault::RenderPanics), "an injected bug");
+        Integrator::prepare(&stage, &film, visible_radius, job.photon_maps.clone(), context)
+    });
     let Some(mut integrator) = prepared else {
         return;
     };

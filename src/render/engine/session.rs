@@ -2,6 +2,7 @@
 //! with a new scene snapshot, cancel, and read the events of the worker
 //! thread from a channel. Nothing here ever blocks the caller.
 
+use std::panic::AssertUnwindSafe;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -111,7 +112,19 @@ fn worker_loop(
             events: &events,
             notify: notify.as_ref(),
         };
-        run_job(workers, &context, &job);
+        // A bug that panics fails its job, and the session goes on: waiting
+        // for the job's end would otherwise never end (the session holds a
+        // sender of its own)
+        let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| run_job(workers, &context, &job)));
+        if let Err(payload) = outcome {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            let message = format!("the render stopped on a bug (please report it): {what}");
+            context.send(RenderEvent::Failed { generation: job_generation, message });
+        }
     }
 }
 
