@@ -167,12 +167,9 @@ fn photons_and_paths_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
 /// Where pane `index`'s last SPPM pass spent its time: a line of figures
 /// and a bar a stage.
 fn sppm_times_ui(ui: &mut egui::Ui, index: usize, times: &SppmTimes, height: f32) {
-    let stages = times.stages();
-    let figures: Vec<String> =
-        stages.iter().map(|(stage, time)| format!("{stage} {:.0} ms", time.as_secs_f64() * 1e3)).collect();
-    ui.small(format!("{}: SPPM last pass: {}", index + 1, figures.join(" · ")));
+    ui.small(format!("{}: SPPM last pass: {}", index + 1, times.summary()));
     Plot::new(("sppm_times", index)).legend(Legend::default()).height(height * 0.5).show(ui, |plot| {
-        for (x, (stage, time)) in stages.iter().enumerate() {
+        for (x, (stage, time)) in times.stages().iter().enumerate() {
             let bar = Bar::new(x as f64, time.as_secs_f64() * 1e3).width(0.8);
             plot.bar_chart(BarChart::new(*stage, vec![bar]));
         }

@@ -204,17 +204,7 @@ pub fn print_photon_statistics(outcome: &RenderOutcome) {
             photon.photons_traced,
             photon.photons_stored,
         );
-        let stages: Vec<String> = photon
-            .times
-            .stages()
-            .iter()
-            .map(|(stage, time)| {
-                // Three decimals for short stages (a small render's are microseconds)
-                let ms = time.as_secs_f64() * 1e3;
-                format!("{stage} {ms:.*} ms", if ms < 10.0 { 3 } else { 0 })
-            })
-            .collect();
-        println!("SPPM last pass: {}", stages.join(", "));
+        println!("SPPM last pass: {}", photon.times.summary());
     }
 }
 

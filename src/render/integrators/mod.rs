@@ -84,6 +84,20 @@ impl SppmTimes {
     pub fn stages(&self) -> [(&'static str, Duration); 4] {
         [("eye pass", self.eye), ("photon tracing", self.trace), ("kd-tree", self.build), ("gather", self.gather)]
     }
+
+    /// "eye pass 95 ms, photon tracing 364 ms, …": three decimals for a
+    /// stage under 10 ms (a small render's are microseconds).
+    pub fn summary(&self) -> String {
+        let stages: Vec<String> = self
+            .stages()
+            .iter()
+            .map(|(stage, time)| {
+                let ms = time.as_secs_f64() * 1e3;
+                format!("{stage} {ms:.*} ms", if ms < 10.0 { 3 } else { 0 })
+            })
+            .collect();
+        stages.join(", ")
+    }
 }
 
 /// What one pass did.

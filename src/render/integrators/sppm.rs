@@ -16,7 +16,7 @@ use super::next_event::PathScope;
 use super::photon_map::kdtree::PhotonKdTree;
 use super::photon_map::trace::{trace_photons_until, MapKind};
 use super::specular::{follow_specular, Emission, Landing};
-use super::{Counters, PassObserver, PassReport, Stage};
+use super::{Counters, PassObserver, PassReport, SppmTimes, Stage};
 use crate::faults::{self, Fault};
 use crate::geometry::Ray;
 use crate::render::film::Film;
@@ -105,8 +105,7 @@ impl Sppm {
         for counters in &per_tile {
             report.counters.add(counters);
         }
-        let times = &mut report.photon.times;
-        times.eye = eye_start.elapsed();
+        let mut times = SppmTimes { eye: eye_start.elapsed(), ..SppmTimes::default() };
         let trace_start = Instant::now();
         let count = self.photons_per_pass;
         let keep_going = || observer.is_current();
@@ -117,7 +116,7 @@ impl Sppm {
         report.photon.photons_stored = photons.len() as u64;
         let build_start = Instant::now();
         let tree = PhotonKdTree::build(photons);
-        report.photon.times.build = build_start.elapsed();
+        times.build = build_start.elapsed();
         if !observer.is_current() {
             return None;
         }
@@ -147,7 +146,8 @@ impl Sppm {
         if !observer.is_current() {
             return None;
         }
-        report.photon.times.gather = gather_start.elapsed();
+        times.gather = gather_start.elapsed();
+        report.photon.times = times;
         let (sum, count) = radii.iter().fold((0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
         report.photon.mean_radius = (sum / count.max(1) as f64) as f32;
         Some(report)
