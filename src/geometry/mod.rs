@@ -18,6 +18,7 @@ pub(crate) use sphere::sphere_hit;
 pub use sphere::sphere_t;
 pub(crate) use triangle::{edges_of, may_reach_of, shear_of, triangle_hit_of, watertight_hit_of};
 pub use triangle::{intersect_triangle, Triangle};
+pub(crate) use triangle::{watertight_finish_of, watertight_range_of};
 
 use glam::Vec3;
 use real::{Real, V3};

@@ -151,7 +151,16 @@ pub fn edges_of<R: Real>([p0, p1, p2]: [V3<R>; 3]) -> [R; 3] {
 /// The watertight test's verdict from the sheared vertices and their edge
 /// functions: (t, whether the ray hits within (δt, t_max), barycentrics).
 #[inline(always)]
-pub fn watertight_hit_of<R: Real>(sheared: [V3<R>; 3], [e0, e1, e2]: [R; 3], sz: R, t_max: R) -> (R, R::Mask, [R; 3]) {
+pub fn watertight_hit_of<R: Real>(sheared: [V3<R>; 3], edges: [R; 3], sz: R, t_max: R) -> (R, R::Mask, [R; 3]) {
+    let range = watertight_range_of(sheared, edges, sz, t_max);
+    watertight_finish_of(sheared, edges, range)
+}
+
+/// The watertight test's first half, what needs no division: whether the
+/// edge functions agree in sign and the scaled distance lies within
+/// (0, t_max). Lanes that fail it (`Range::missed`) miss.
+#[inline(always)]
+pub fn watertight_range_of<R: Real>(sheared: [V3<R>; 3], [e0, e1, e2]: [R; 3], sz: R, t_max: R) -> Range<R> {
     let zero = R::splat(0.0);
     let [p0, p1, p2] = sheared;
     // Inside when the edge functions do not differ in sign
@@ -159,11 +168,35 @@ pub fn watertight_hit_of<R: Real>(sheared: [V3<R>; 3], [e0, e1, e2]: [R; 3], sz:
     let positive = e0.gt(zero).or(e1.gt(zero)).or(e2.gt(zero));
     let det = e0 + e1 + e2;
     // Scaled distance, tested against the range before dividing
-    let (z0, z1, z2) = (p0.z * sz, p1.z * sz, p2.z * sz);
-    let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
+    let z = [p0.z * sz, p1.z * sz, p2.z * sz];
+    let t_scaled = e0 * z[0] + e1 * z[1] + e2 * z[2];
     let bound = t_max * det;
     let behind_or_beyond = (det.lt(zero).and(t_scaled.ge(zero).or(t_scaled.lt(bound))))
         .or(det.gt(zero).and(t_scaled.le(zero).or(t_scaled.gt(bound))));
+    let missed = negative.and(positive).or(det.eq(zero)).or(behind_or_beyond);
+    Range { missed, det, t_scaled, z }
+}
+
+/// `watertight_range_of`'s findings: the lanes out of range or of the
+/// triangle, and what the rest of the test reads.
+#[derive(Clone, Copy)]
+pub struct Range<R: Real> {
+    pub missed: R::Mask,
+    pub det: R,
+    pub t_scaled: R,
+    z: [R; 3],
+}
+
+/// The watertight test's second half: (t, hit, barycentrics), a hit only
+/// within range and beyond the distance rounding could fake (pbrt's δt).
+#[inline(always)]
+pub fn watertight_finish_of<R: Real>(
+    sheared: [V3<R>; 3],
+    [e0, e1, e2]: [R; 3],
+    range: Range<R>,
+) -> (R, R::Mask, [R; 3]) {
+    let [p0, p1, p2] = sheared;
+    let Range { missed, det, t_scaled, z: [z0, z1, z2] } = range;
     let inv_det = R::splat(1.0) / det;
     let barycentrics = [e0 * inv_det, e1 * inv_det, e2 * inv_det];
     let t = t_scaled * inv_det;
@@ -177,12 +210,7 @@ pub fn watertight_hit_of<R: Real>(sheared: [V3<R>; 3], [e0, e1, e2]: [R; 3], sz:
     let delta_e = (max_xt * gamma(2) * max_yt + delta_y * max_xt + delta_x * max_yt) * 2.0;
     let max_e = V3::new(e0, e1, e2).abs().max_element();
     let delta_t = (max_e * gamma(3) * max_zt + delta_e * max_zt + delta_z * max_e) * 3.0 * inv_det.abs();
-    let hit = t
-        .is_finite()
-        .and_not(t.le(delta_t))
-        .and_not(negative.and(positive))
-        .and_not(det.eq(zero))
-        .and_not(behind_or_beyond);
+    let hit = t.is_finite().and_not(t.le(delta_t)).and_not(missed);
     (t, hit, barycentrics)
 }
 

@@ -12,19 +12,21 @@ pub mod rng;
 pub mod sampling;
 pub mod shapes;
 pub mod spheres;
+pub mod triangles;
 
 use glam::Vec3;
 
 use crate::geometry::real::V3;
 use crate::geometry::sphere::{wall_exit, wall_exit_hit, wall_slack};
-use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
 use crate::geometry::{plane_exit_t, plane_hit, plane_t, sphere_hit};
+use crate::geometry::{Ray, SurfaceHit, Triangle};
 use crate::scene::{LightKind, MaterialModel, Rgb, Shape, ValidScene};
 use camera::CameraModel;
 use light::{Emitter, EmitterCap, LightSource};
 use occluders::{Occluders, Walls};
 pub use shapes::{ObjectInfo, PlaneShape, ShapeRef, Spheres};
 use spheres::SphereLanes;
+use triangles::TriangleLanes;
 
 /// What `intersect_held` found nearest.
 enum Inside<'w> {
@@ -48,6 +50,8 @@ pub struct World {
     pub spheres: Spheres,
     pub planes: Vec<PlaneShape>,
     pub triangles: Vec<(Triangle, u32)>,
+    /// The same triangles four to a SIMD group, for the hit loops.
+    pub(crate) triangle_lanes: TriangleLanes,
     pub objects: Vec<ObjectInfo>,
     pub materials: Vec<MaterialModel>,
     pub lights: Vec<LightSource>,
@@ -114,6 +118,7 @@ impl World {
             spheres: Spheres::default(),
             planes: Vec::new(),
             triangles: Vec::new(),
+            triangle_lanes: TriangleLanes::default(),
             objects: Vec::with_capacity(scene.objects.len()),
             materials: scene.materials.iter().map(|m| m.model.clone()).collect(),
             lights: Vec::new(),
@@ -157,6 +162,7 @@ impl World {
         let centers: Vec<Vec3> = (0..world.spheres.radius.len()).map(|i| world.spheres.center(i)).collect();
         let ids = (0..centers.len() as u32).collect();
         world.spheres.lanes = SphereLanes::new(&centers, &world.spheres.radius, ids);
+        world.triangle_lanes = TriangleLanes::new(&world.triangles);
         if lo.x <= hi.x {
             world.bounds_center = (lo + hi) * 0.5;
             world.bounds_radius = (hi - lo).length() * 0.5;
@@ -247,13 +253,10 @@ impl World {
                 best = Some(ShapeRef::Plane(i as u32));
             }
         }
-        let mut triangle_hit = None;
-        for (i, (triangle, _)) in self.triangles.iter().enumerate() {
-            if let Some(hit) = intersect_triangle(ray, triangle, best_t) {
-                best_t = hit.t;
-                best = Some(ShapeRef::Triangle(i as u32));
-                triangle_hit = Some(hit);
-            }
+        let triangle_hit = self.triangle_lanes.nearest(&self.triangles, ray, best_t);
+        if let Some((i, hit)) = triangle_hit {
+            best_t = hit.t;
+            best = Some(ShapeRef::Triangle(i));
         }
         let (surface, object) = match best? {
             ShapeRef::Sphere(i) => {
@@ -264,7 +267,7 @@ impl World {
                 let plane = &self.planes[i as usize];
                 (plane_hit(ray, plane.normal, plane.offset, best_t), plane.object)
             }
-            ShapeRef::Triangle(i) => (triangle_hit?, self.triangles[i as usize].1),
+            ShapeRef::Triangle(i) => (triangle_hit?.1, self.triangles[i as usize].1),
         };
         Some(Hit { surface, object, material: self.objects[object as usize].material })
     }
@@ -281,7 +284,8 @@ impl World {
     #[inline]
     pub fn occluders(&self, held: bool) -> Occluders<'_> {
         let s = self;
-        Occluders::for_path(&s.walls, &s.spheres.lanes, &s.planes, &s.triangles, &s.light_plane, held)
+        let triangles = (&s.triangles[..], &s.triangle_lanes);
+        Occluders::for_path(&s.walls, &s.spheres.lanes, &s.planes, triangles, &s.light_plane, held)
     }
 
     /// `intersect` for a path `held` inside every wall (`holds` of where it
@@ -323,13 +327,10 @@ impl World {
                 best = Some(Inside::Plane(&wall.plane));
             }
         }
-        let mut triangle_hit = None;
-        for (i, (triangle, _)) in self.triangles.iter().enumerate() {
-            if let Some(hit) = intersect_triangle(ray, triangle, best_t) {
-                best_t = hit.t;
-                best = Some(Inside::Triangle(i as u32));
-                triangle_hit = Some(hit);
-            }
+        let triangle_hit = self.triangle_lanes.nearest(&self.triangles, ray, best_t);
+        if let Some((i, hit)) = triangle_hit {
+            best_t = hit.t;
+            best = Some(Inside::Triangle(i));
         }
         let (surface, object) = match best? {
             Inside::Sphere(i, near) => {
@@ -344,7 +345,7 @@ impl World {
                 (surface, s.object[*i as usize])
             }
             Inside::Plane(plane) => (plane_hit(ray, plane.normal, plane.offset, best_t), plane.object),
-            Inside::Triangle(i) => (triangle_hit?, self.triangles[i as usize].1),
+            Inside::Triangle(i) => (triangle_hit?.1, self.triangles[i as usize].1),
         };
         Some(Hit { surface, object, material: self.objects[object as usize].material })
     }
@@ -355,7 +356,7 @@ impl World {
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.spheres.lanes.any_hit(ray, t_max)
             || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
-            || self.triangles.iter().any(|(t, _)| intersect_triangle(ray, t, t_max).is_some())
+            || self.triangle_lanes.any_hit(&self.triangles, ray, t_max, |_| false)
     }
 
     /// The world as a render through `camera` at width × height uses it

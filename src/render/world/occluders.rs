@@ -15,8 +15,9 @@ use super::lanes::{F8, LANES, M8, V8};
 use super::light::{Emitter, LightSample, LightSource};
 use super::shapes::{PlaneShape, Spheres};
 use super::spheres::SphereLanes;
+use super::triangles::TriangleLanes;
 use crate::geometry::sphere::AnchoredSphere;
-use crate::geometry::{gamma, intersect_triangle, plane_t};
+use crate::geometry::{gamma, plane_t};
 use crate::geometry::{Ray, Triangle};
 
 /// A region a wall bounds, in f64 for exact inside tests.
@@ -254,6 +255,7 @@ pub struct Occluders<'w> {
     spheres: &'w SphereLanes,
     planes: &'w [PlaneShape],
     triangles: &'w [(Triangle, u32)],
+    triangle_lanes: &'w TriangleLanes,
     /// Per triangle, the light triangle whose plane holds it (`u32::MAX` if none).
     light_plane: &'w [u32],
 }
@@ -266,12 +268,12 @@ impl<'w> Occluders<'w> {
         walls: &'w Walls,
         spheres: &'w SphereLanes,
         planes: &'w [PlaneShape],
-        triangles: &'w [(Triangle, u32)],
+        (triangles, triangle_lanes): (&'w [(Triangle, u32)], &'w TriangleLanes),
         light_plane: &'w [u32],
         held: bool,
     ) -> Self {
         let (spheres, planes) = if held { (&walls.spheres, &walls.planes[..]) } else { (spheres, planes) };
-        Occluders { spheres, planes, triangles, light_plane }
+        Occluders { spheres, planes, triangles, triangle_lanes, light_plane }
     }
 
     /// Whether anything lies on `ray` before `t_max` (a connection of two
@@ -280,7 +282,7 @@ impl<'w> Occluders<'w> {
     pub fn segment_blocked(&self, ray: &Ray, t_max: f32) -> bool {
         self.spheres.any_hit_except(ray, t_max, None)
             || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
-            || self.triangles.iter().any(|(triangle, _)| intersect_triangle(ray, triangle, t_max).is_some())
+            || self.triangle_lanes.any_hit(self.triangles, ray, t_max, |_| false)
     }
 
     /// Whether anything lies between the shading point and the light sample.
@@ -290,16 +292,15 @@ impl<'w> Occluders<'w> {
         let light_plane = sample.on_triangle.map(|t| self.light_plane[t as usize]);
         self.spheres.any_hit_except(ray, t_max, sample.on_sphere)
             || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
-            || self.triangles.iter().zip(self.light_plane).any(|((triangle, _), plane)| {
-                light_plane != Some(*plane) && intersect_triangle(ray, triangle, t_max).is_some()
-            })
+            || (self.triangle_lanes)
+                .any_hit(self.triangles, ray, t_max, |i| light_plane == Some(self.light_plane[i as usize]))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{sphere_t, Ray};
+    use crate::geometry::{intersect_triangle, sphere_t, Ray};
     use crate::render::world::camera::CameraModel;
     use crate::render::world::rng::Sampler;
     use crate::render::world::sampling::uniform_sphere;

@@ -1,0 +1,255 @@
+//! Triangles tested four at a time against one ray: the watertight test of
+//! `geometry::triangle`, the same generic code over glam's `Vec4` (SSE on
+//! x86-64), so a ray pays one pass of vector instructions per group of four
+//! instead of four scalar tests. What the scalar test decides, hit or miss,
+//! t and point, the lanes decide bit for bit: the arithmetic is the same
+//! operation for operation, the rare ray whose edge function is exactly
+//! zero (redone in f64 there) is handed to the scalar test, and hits are
+//! taken in the scalar loop's order.
+
+use glam::{BVec4A, Vec4};
+
+use crate::geometry::real::V3;
+use crate::geometry::{edges_of, may_reach_of, shear_of, triangle_hit_of, watertight_finish_of, watertight_range_of};
+use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
+
+/// Four triangles' vertices and bounding balls, lane by lane.
+#[derive(Clone, Debug)]
+struct Group {
+    vertices: [V3<Vec4>; 3],
+    center: V3<Vec4>,
+    radius: Vec4,
+    /// Lanes that hold a triangle (the last group may be part empty).
+    full: u32,
+}
+
+/// What one group's lanes found for a ray within (0, t_max).
+struct Verdict {
+    /// Lanes hit within (0, t_max), by the f32 test.
+    hit: u32,
+    /// Lanes the ball lets through whose edge functions met an exact zero:
+    /// the scalar test decides them (in f64).
+    scalar: u32,
+    t: Vec4,
+    t_scaled: Vec4,
+    det: Vec4,
+    barycentrics: [Vec4; 3],
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct TriangleLanes {
+    groups: Vec<Group>,
+    /// The world's index of the triangle in each lane, in order
+    /// (degenerate triangles, which nothing hits, are left out).
+    ids: Vec<u32>,
+}
+
+impl TriangleLanes {
+    pub fn new(triangles: &[(Triangle, u32)]) -> Self {
+        let ids: Vec<u32> = (0..triangles.len() as u32).filter(|&i| !triangles[i as usize].0.is_degenerate()).collect();
+        let groups = ids
+            .chunks(4)
+            .map(|chunk| {
+                // Empty lanes copy the first triangle and are masked off by `full`
+                let lane = |k: usize| &triangles[chunk[k.min(chunk.len() - 1)] as usize].0;
+                let vec = |f: &dyn Fn(&Triangle) -> f32| Vec4::from_array([0, 1, 2, 3].map(|k| f(lane(k))));
+                let point =
+                    |f: &dyn Fn(&Triangle) -> glam::Vec3| V3::new(vec(&|t| f(t).x), vec(&|t| f(t).y), vec(&|t| f(t).z));
+                Group {
+                    vertices: [point(&|t| t.vertices[0]), point(&|t| t.vertices[1]), point(&|t| t.vertices[2])],
+                    center: point(&|t| t.bound().0),
+                    radius: vec(&|t| t.bound().1),
+                    full: (1 << chunk.len()) - 1,
+                }
+            })
+            .collect();
+        TriangleLanes { groups, ids }
+    }
+
+    /// One group against `ray` within (0, t_max); `None` where its balls
+    /// turn the ray away in every lane (most groups, for most rays).
+    #[inline(always)]
+    fn verdict(group: &Group, ray: &Ray, t_max: f32) -> Option<Verdict> {
+        let (origin, direction) = (V3::<Vec4>::splat(ray.origin), V3::<Vec4>::splat(ray.direction));
+        let limit = Vec4::splat(t_max);
+        let reach = may_reach_of(origin, direction, group.center, group.radius, limit).bitmask() & group.full;
+        if reach == 0 {
+            return None;
+        }
+        let (sheared, sz) = shear_of(origin, direction, group.vertices);
+        let edges = edges_of(sheared);
+        let zero = Vec4::ZERO;
+        let on_edge: BVec4A = edges[0].cmpeq(zero) | edges[1].cmpeq(zero) | edges[2].cmpeq(zero);
+        let scalar = on_edge.bitmask() & reach;
+        let range = watertight_range_of(sheared, edges, sz, limit);
+        let within = reach & !range.missed.bitmask() & !scalar;
+        if within == 0 && scalar == 0 {
+            return None;
+        }
+        let (t, hit, barycentrics) = watertight_finish_of(sheared, edges, range);
+        let (t_scaled, det) = (range.t_scaled, range.det);
+        Some(Verdict { hit: hit.bitmask() & within, scalar, t, t_scaled, det, barycentrics })
+    }
+
+    /// Nearest hit in (0, t_max): (the world's triangle index, the hit),
+    /// exactly what `intersect_triangle` over the triangles in order finds.
+    #[inline]
+    pub fn nearest(&self, triangles: &[(Triangle, u32)], ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
+        let mut best_t = t_max;
+        let mut found = None;
+        for (g, group) in self.groups.iter().enumerate() {
+            let Some(verdict) = Self::verdict(group, ray, best_t) else { continue };
+            let (mut lanes, mut narrowed) = (verdict.hit | verdict.scalar, false);
+            while lanes != 0 {
+                let lane = lanes.trailing_zeros() as usize;
+                lanes &= lanes - 1;
+                let id = self.ids[g * 4 + lane];
+                let triangle = &triangles[id as usize].0;
+                if verdict.scalar & (1 << lane) != 0 {
+                    if let Some(hit) = intersect_triangle(ray, triangle, best_t) {
+                        (best_t, narrowed) = (hit.t, true);
+                        found = Some((id, hit));
+                    }
+                    continue;
+                }
+                // An earlier lane of this group may have brought t_max
+                // nearer: the scalar loop would test both ball and hit
+                // against it
+                if narrowed {
+                    let (center, radius) = triangle.bound();
+                    let (origin, direction) = (V3::from(ray.origin), V3::from(ray.direction));
+                    let (t_scaled, det) = (verdict.t_scaled.to_array()[lane], verdict.det.to_array()[lane]);
+                    let bound = best_t * det;
+                    if !may_reach_of(origin, direction, V3::from(center), radius, best_t)
+                        || (det < 0.0 && t_scaled < bound)
+                        || (det > 0.0 && t_scaled > bound)
+                    {
+                        continue;
+                    }
+                }
+                let b = verdict.barycentrics.map(|b| b.to_array()[lane]);
+                let (point, error) = triangle_hit_of(triangle.vertices.map(V3::from), b);
+                (best_t, narrowed) = (verdict.t.to_array()[lane], true);
+                found = Some((id, SurfaceHit { t: best_t, point: point.into(), normal: triangle.normal, error }));
+            }
+        }
+        found
+    }
+
+    /// Whether any triangle but those `skip` names lies on the ray in
+    /// (0, t_max).
+    #[inline]
+    pub fn any_hit(&self, triangles: &[(Triangle, u32)], ray: &Ray, t_max: f32, skip: impl Fn(u32) -> bool) -> bool {
+        self.groups.iter().enumerate().any(|(g, group)| {
+            let Some(verdict) = Self::verdict(group, ray, t_max) else { return false };
+            let mut lanes = verdict.hit | verdict.scalar;
+            while lanes != 0 {
+                let lane = lanes.trailing_zeros() as usize;
+                lanes &= lanes - 1;
+                let id = self.ids[g * 4 + lane];
+                if skip(id) {
+                    continue;
+                }
+                if verdict.hit & (1 << lane) != 0 || intersect_triangle(ray, &triangles[id as usize].0, t_max).is_some()
+                {
+                    return true;
+                }
+            }
+            false
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::render::world::rng::Sampler;
+    use crate::render::world::sampling::uniform_sphere;
+
+    /// Quads split in two and fans about a shared vertex (rays through
+    /// shared edges and vertices, where the f64 fallback runs), and loose
+    /// triangles, some degenerate.
+    fn triangles(s: &mut Sampler, count: usize) -> Vec<(Triangle, u32)> {
+        let mut out = Vec::new();
+        let point = |s: &mut Sampler| (Vec3::new(s.next_f32(), s.next_f32(), s.next_f32()) - 0.5) * 6.0;
+        while out.len() < count {
+            let (a, b, c, d) = (point(s), point(s), point(s), point(s));
+            match out.len() % 4 {
+                0 => {
+                    out.push(Triangle::new(a, b, c));
+                    out.push(Triangle::new(a, c, a + (c - b)));
+                }
+                1 => out.push(Triangle::new(a, a, b)),
+                2 => {
+                    // Axis-aligned, through the origin's grid: edge functions of zero
+                    let z = a.z.round();
+                    let (p, q) = (Vec3::new(0.0, 0.0, z), Vec3::new(1.0, 0.0, z));
+                    out.push(Triangle::new(p, q, Vec3::new(0.0, 1.0, z)));
+                    out.push(Triangle::new(q, Vec3::new(1.0, 1.0, z), Vec3::new(0.0, 1.0, z)));
+                }
+                _ => out.push(Triangle::new(a, b, d)),
+            }
+        }
+        out.truncate(count);
+        out.into_iter().zip(0..).collect()
+    }
+
+    /// Nearest hits and shadow tests agree with the scalar loop bit for bit.
+    #[test]
+    fn lanes_match_the_scalar_test_triangle_by_triangle() {
+        let mut s = Sampler::new(0, 0, 7);
+        let (mut hits, mut on_edges) = (0, 0);
+        for count in [1usize, 3, 4, 5, 8, 11] {
+            let list = triangles(&mut s, count);
+            let lanes = TriangleLanes::new(&list);
+            for k in 0..4000 {
+                let origin = uniform_sphere(s.next_2d()) * 8.0 * s.next_f32();
+                // Every third ray aims at a vertex or a grid point, to land on edges
+                let ray = match k % 4 {
+                    0 => {
+                        let target = list[k % count].0.vertices[k % 3];
+                        Ray::new(origin, (target - origin).normalize())
+                    }
+                    // Down the z axis through the grid's corners and edges
+                    1 => {
+                        let (x, y) = ((k / 4 % 3) as f32 * 0.5, (k / 12 % 3) as f32 * 0.5);
+                        Ray::new(Vec3::new(x, y, 5.0), -Vec3::Z)
+                    }
+                    2 => Ray::new(origin, (Vec3::new((k % 2) as f32, 0.0, (k % 5) as f32 - 2.0) - origin).normalize()),
+                    _ => Ray::new(origin, uniform_sphere(s.next_2d())),
+                };
+                let t_max = if s.next_f32() < 0.3 { 4.0 } else { f32::INFINITY };
+                let mut expected: Option<(u32, SurfaceHit)> = None;
+                for (i, (triangle, _)) in list.iter().enumerate() {
+                    if let Some(hit) = intersect_triangle(&ray, triangle, expected.map_or(t_max, |e| e.1.t)) {
+                        expected = Some((i as u32, hit));
+                    }
+                }
+                let got = lanes.nearest(&list, &ray, t_max);
+                assert_eq!(got.map(|g| g.0), expected.map(|e| e.0), "ray {ray:?}");
+                if let (Some((_, a)), Some((_, b))) = (got, expected) {
+                    hits += 1;
+                    assert_eq!([a.t, a.error], [b.t, b.error]);
+                    assert_eq!((a.point, a.normal), (b.point, b.normal));
+                }
+                let skipped = (k % count) as u32;
+                let scalar_any = |skip: Option<u32>| {
+                    (list.iter().enumerate())
+                        .any(|(i, (t, _))| Some(i as u32) != skip && intersect_triangle(&ray, t, t_max).is_some())
+                };
+                assert_eq!(lanes.any_hit(&list, &ray, t_max, |_| false), scalar_any(None));
+                assert_eq!(lanes.any_hit(&list, &ray, t_max, |id| id == skipped), scalar_any(Some(skipped)));
+                let (origin, direction) = (V3::<f32>::from(ray.origin), V3::<f32>::from(ray.direction));
+                on_edges += list
+                    .iter()
+                    .filter(|(t, _)| edges_of(shear_of(origin, direction, t.vertices.map(V3::from)).0).contains(&0.0))
+                    .count();
+            }
+        }
+        // The test saw hits, and rays whose edge functions were exactly zero
+        assert!(hits > 2000, "{hits} hits");
+        assert!(on_edges > 100, "{on_edges} rays on edges");
+    }
+}
