@@ -313,6 +313,66 @@ mod tests {
         }
     }
 
+    /// SSIM against an oracle written out from Wang et al.'s definition in
+    /// f64, another way: the 2-D Gaussian taken whole, variances and the
+    /// covariance as weighted second moments about the mean (not E[x²] −
+    /// m²), sRGB from its formula in f64, Rec. 709 luminance. Colour images
+    /// under an exposure that clips some pixels; windows cut by every border
+    /// (9 × 7 is smaller than the 11 × 11 window).
+    #[test]
+    fn ssim_agrees_with_the_definition_written_out() {
+        fn luminance(p: [f32; 3], exposure: f64) -> f64 {
+            let encode = |c: f32| {
+                let v = (c as f64 * exposure.exp2()).clamp(0.0, 1.0);
+                if v <= 0.0031308 {
+                    12.92 * v
+                } else {
+                    1.055 * v.powf(1.0 / 2.4) - 0.055
+                }
+            };
+            0.2126 * encode(p[0]) + 0.7152 * encode(p[1]) + 0.0722 * encode(p[2])
+        }
+        fn oracle(a: &LinearImage, b: &LinearImage, exposure: f64) -> f64 {
+            let (w, h) = (a.width as i64, a.height as i64);
+            let (c1, c2) = (0.0001, 0.0009);
+            let mut total = 0.0;
+            for (py, px) in (0..h).flat_map(|y| (0..w).map(move |x| (y, x))) {
+                let window: Vec<(f64, f64, f64)> = (0..h)
+                    .flat_map(|y| (0..w).map(move |x| (y, x)))
+                    .filter(|(y, x)| (y - py).abs() <= 5 && (x - px).abs() <= 5)
+                    .map(|(y, x)| {
+                        let d2 = ((y - py).pow(2) + (x - px).pow(2)) as f64;
+                        let i = (y * w + x) as usize;
+                        ((-d2 / 4.5).exp(), luminance(a.pixels[i], exposure), luminance(b.pixels[i], exposure))
+                    })
+                    .collect();
+                let weight: f64 = window.iter().map(|t| t.0).sum();
+                let mean =
+                    |f: &dyn Fn(&(f64, f64, f64)) -> f64| window.iter().map(|t| t.0 * f(t)).sum::<f64>() / weight;
+                let (mx, my) = (mean(&|t| t.1), mean(&|t| t.2));
+                let vx = mean(&|t| (t.1 - mx).powi(2));
+                let vy = mean(&|t| (t.2 - my).powi(2));
+                let cov = mean(&|t| (t.1 - mx) * (t.2 - my));
+                total += (2.0 * mx * my + c1) * (2.0 * cov + c2) / ((mx * mx + my * my + c1) * (vx + vy + c2));
+            }
+            total / (w * h) as f64
+        }
+        let colour = |seed: u64| {
+            let s = std::cell::RefCell::new(Sampler::new(0, 0, seed));
+            image(9, 7, move |_, _| {
+                let mut s = s.borrow_mut();
+                [s.next_f32() * 1.5, s.next_f32(), s.next_f32() * 0.3]
+            })
+        };
+        let (a, b) = (colour(11), colour(12));
+        let c = noisy(&a, 0.2, 4);
+        for (exposure, x, y) in [(0.0, &a, &b), (0.0, &a, &c), (1.0, &c, &a), (-2.0, &b, &c)] {
+            let expected = oracle(x, y, exposure as f64);
+            let got = ssim(x, y, exposure).unwrap();
+            assert!((got - expected).abs() < 1e-6, "exposure {exposure}: {got} against {expected}");
+        }
+    }
+
     #[test]
     fn flip_is_zero_for_identical_and_grows_with_noise() {
         let a = gradient();
