@@ -389,5 +389,7 @@ mod tests {
         assert_eq!(colours[1], [252, 253, 191, 255]);
         assert_eq!(colours[2], colours[1]);
         assert_eq!(colours[3], FLAG_COLOUR);
+        // An error map with no error (max 0) is all the bottom colour
+        assert_eq!(false_colour(&[0.0, 0.5], 0.0), vec![[0, 0, 4, 255]; 2]);
     }
 }
