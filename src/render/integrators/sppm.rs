@@ -196,10 +196,12 @@ impl SppmPixel {
         };
         let mut flux = Rgb::ZERO;
         let mut found = 0u32;
+        let constant = vp.bsdf.front_constant(vp.wo, vp.facing);
         tree.for_each_within(vp.point, self.radius, |photon| {
             let incoming = photon.incoming_direction();
             if incoming.dot(vp.facing) < 0.0 {
-                flux += vp.bsdf.eval(vp.wo, -incoming, vp.facing) * Vec3::from_array(photon.power);
+                let f = constant.unwrap_or_else(|| vp.bsdf.eval(vp.wo, -incoming, vp.facing));
+                flux += f * Vec3::from_array(photon.power);
                 found += 1;
             }
         });

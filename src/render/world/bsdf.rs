@@ -234,6 +234,17 @@ impl Bsdf {
         self.eval_pdf(wo, wi, n).0
     }
 
+    /// `eval(wo, wi, n)` for every `wi` in front of `n` (`wi · n > 0`),
+    /// where that is one value (Lambert's): a density estimate then looks it
+    /// up once per point, not once per photon.
+    #[inline]
+    pub fn front_constant(&self, wo: Vec3, n: Vec3) -> Option<Rgb> {
+        match self {
+            Bsdf::Lambert { .. } => Some(self.eval(wo, n, n)),
+            _ => None,
+        }
+    }
+
     /// Solid-angle pdf of `sample` choosing `wi`.
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3, n: Vec3) -> f32 {
@@ -323,6 +334,7 @@ impl Bsdf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::world::sampling::uniform_sphere;
 
     fn directional_albedo(bsdf: &Bsdf, wo: Vec3, n: usize) -> Rgb {
         let mut s = Sampler::new(0, 0, 5);
@@ -350,6 +362,30 @@ mod tests {
                     assert!((expected - b.weight).abs().max_element() < 1e-3 * (1.0 + expected.max_element()));
                 }
             }
+        }
+    }
+
+    /// Where `front_constant` answers, it is `eval` for every direction in
+    /// front, bit for bit, on either side of the surface; the lobes that
+    /// depend on the direction do not answer.
+    #[test]
+    fn a_front_constant_is_eval_for_every_direction_in_front() {
+        let mut s = Sampler::new(2, 2, 2);
+        let lambert = Bsdf::Lambert { albedo: Vec3::new(0.7, 0.5, 0.2) };
+        for _ in 0..2000 {
+            let n = uniform_sphere(s.next_2d());
+            let (wo, wi) = (uniform_sphere(s.next_2d()), uniform_sphere(s.next_2d()));
+            let wi = if wi.dot(n) > 0.0 { wi } else { -wi };
+            let constant = lambert.front_constant(wo, n).expect("Lambert's value is one");
+            assert_eq!(constant, lambert.eval(wo, wi, n), "wo {wo}, wi {wi}, n {n}");
+        }
+        for bsdf in [
+            Bsdf::Phong { kd: Vec3::splat(0.3), ks: Vec3::splat(0.6), exponent: 20.0 },
+            Bsdf::BlinnPhong { kd: Vec3::splat(0.2), ks: Vec3::splat(0.7), exponent: 50.0 },
+            Bsdf::Mirror { tint: Vec3::ONE },
+            Bsdf::Glass { ior: 1.5, tint: Vec3::ONE },
+        ] {
+            assert_eq!(bsdf.front_constant(Vec3::Z, Vec3::Z), None, "{bsdf:?}");
         }
     }
 
