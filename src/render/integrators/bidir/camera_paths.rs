@@ -225,9 +225,9 @@ fn direct(
     let Some((index, pick)) = ctx.picker.pick(sampler.next_f32()) else { return none };
     let light = &ctx.world.lights[index];
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
-    let shade = |sample: &LightSample| Some(bsdf.eval(wo, sample.wi, facing)).filter(|f| *f != Rgb::ZERO);
+    let shade = |sample: &LightSample| Some(bsdf.eval_pdf(wo, sample.wi, facing)).filter(|(f, _)| *f != Rgb::ZERO);
     counters.connections += 1;
-    let Some((sample, f)) = scope.light_sample(light, vertex.hit, sampler.next_2d(), counters, shade) else {
+    let Some((sample, (f, pdf))) = scope.light_sample(light, vertex.hit, sampler.next_2d(), counters, shade) else {
         return none;
     };
     let point = vertex.hit.surface.point;
@@ -241,7 +241,7 @@ fn direct(
     let from = if light.is_finite() { sample.point } else { point };
     let emission_pdf = light.emission_pdf(ctx.bounds, from, sample.normal, -sample.wi);
     let go_on = bsdf.continuation();
-    let bsdf_pdf = if light.is_delta() { 0.0 } else { bsdf.pdf(wo, sample.wi, facing) * go_on };
+    let bsdf_pdf = if light.is_delta() { 0.0 } else { pdf * go_on };
     let reverse = bsdf.pdf(sample.wi, wo, facing) * go_on;
     let cos = sample.wi.dot(facing);
     let (s, partials) = (&ctx.strategies, vertex.partials);
@@ -263,20 +263,20 @@ fn connect(
     let distance2 = to_light.length_squared();
     let direction = to_light / distance2.sqrt();
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
-    let camera_f = bsdf.eval(wo, direction, facing);
+    let (camera_f, camera_pdf) = bsdf.eval_pdf(wo, direction, facing);
     if camera_f == Rgb::ZERO {
         return none;
     }
     let light_facing = light.facing();
-    let light_f = light.bsdf.eval(light.wo, -direction, light_facing);
+    let (light_f, light_pdf) = light.bsdf.eval_pdf(light.wo, -direction, light_facing);
     if light_f == Rgb::ZERO {
         return none;
     }
     let (cos_camera, cos_light) = (direction.dot(facing), -direction.dot(light_facing));
     let (camera_go_on, light_go_on) = (bsdf.continuation(), light.bsdf.continuation());
-    let camera_pdf_a = bsdf.pdf(wo, direction, facing) * camera_go_on * cos_light / distance2;
+    let camera_pdf_a = camera_pdf * camera_go_on * cos_light / distance2;
     let camera_reverse = bsdf.pdf(direction, wo, facing) * camera_go_on;
-    let light_pdf_a = light.bsdf.pdf(light.wo, -direction, light_facing) * light_go_on * cos_camera / distance2;
+    let light_pdf_a = light_pdf * light_go_on * cos_camera / distance2;
     let light_reverse = light.bsdf.pdf(-direction, light.wo, light_facing) * light_go_on;
     let s = &ctx.strategies;
     let weight =
@@ -312,11 +312,11 @@ fn merge<T: Tally>(
         if light_vertex.length + vertex.length > ctx.max_length {
             return;
         }
-        let f = bsdf.eval(wo, light_vertex.wo, facing);
+        let (f, pdf) = bsdf.eval_pdf(wo, light_vertex.wo, facing);
         if f == Rgb::ZERO {
             return;
         }
-        let camera_pdf = bsdf.pdf(wo, light_vertex.wo, facing) * go_on;
+        let camera_pdf = pdf * go_on;
         // The way back is the light vertex's to continue
         let camera_reverse = bsdf.pdf(light_vertex.wo, wo, facing) * light_vertex.bsdf.continuation();
         let s = &ctx.strategies;
