@@ -158,9 +158,9 @@ pub fn watertight_hit_of<R: Real>(sheared: [V3<R>; 3], edges: [R; 3], sz: R, t_m
 
 /// The watertight test's first half, what needs no division: whether the
 /// edge functions agree in sign and the scaled distance lies within
-/// (0, t_max). Lanes that fail it (`Range::missed`) miss.
+/// (0, t_max). Lanes that fail it (`WatertightRange::missed`) miss.
 #[inline(always)]
-pub fn watertight_range_of<R: Real>(sheared: [V3<R>; 3], [e0, e1, e2]: [R; 3], sz: R, t_max: R) -> Range<R> {
+pub fn watertight_range_of<R: Real>(sheared: [V3<R>; 3], [e0, e1, e2]: [R; 3], sz: R, t_max: R) -> WatertightRange<R> {
     let zero = R::splat(0.0);
     let [p0, p1, p2] = sheared;
     // Inside when the edge functions do not differ in sign
@@ -174,13 +174,13 @@ pub fn watertight_range_of<R: Real>(sheared: [V3<R>; 3], [e0, e1, e2]: [R; 3], s
     let behind_or_beyond = (det.lt(zero).and(t_scaled.ge(zero).or(t_scaled.lt(bound))))
         .or(det.gt(zero).and(t_scaled.le(zero).or(t_scaled.gt(bound))));
     let missed = negative.and(positive).or(det.eq(zero)).or(behind_or_beyond);
-    Range { missed, det, t_scaled, z }
+    WatertightRange { missed, det, t_scaled, z }
 }
 
 /// `watertight_range_of`'s findings: the lanes out of range or of the
 /// triangle, and what the rest of the test reads.
 #[derive(Clone, Copy)]
-pub struct Range<R: Real> {
+pub struct WatertightRange<R: Real> {
     pub missed: R::Mask,
     pub det: R,
     pub t_scaled: R,
@@ -193,10 +193,10 @@ pub struct Range<R: Real> {
 pub fn watertight_finish_of<R: Real>(
     sheared: [V3<R>; 3],
     [e0, e1, e2]: [R; 3],
-    range: Range<R>,
+    range: WatertightRange<R>,
 ) -> (R, R::Mask, [R; 3]) {
     let [p0, p1, p2] = sheared;
-    let Range { missed, det, t_scaled, z: [z0, z1, z2] } = range;
+    let WatertightRange { missed, det, t_scaled, z: [z0, z1, z2] } = range;
     let inv_det = R::splat(1.0) / det;
     let barycentrics = [e0 * inv_det, e1 * inv_det, e2 * inv_det];
     let t = t_scaled * inv_det;
