@@ -438,6 +438,40 @@ mod tests {
         assert!(taken > 1500 && reached as f32 > 0.75 * taken as f32, "{reached} of {taken} samples reached the light");
     }
 
+    /// Samples on the edge of the cone a sphere light subtends: where the
+    /// edge ray misses the sphere by rounding, the sample is the sphere's
+    /// point nearest the ray (within rounding of it), its normal is that
+    /// point's, and it faces the shaded point like every other sample.
+    #[test]
+    fn cone_edge_samples_that_miss_by_rounding_take_the_closest_point() {
+        let mut s = Sampler::new(0, 0, 306);
+        let mut missed = 0;
+        for k in 0..20_000 {
+            let (center, radius) = (Vec3::new(s.next_f32(), s.next_f32(), s.next_f32()) * 4.0, 0.05 + s.next_f32());
+            let p = center
+                + crate::render::world::sampling::uniform_sphere(s.next_2d()) * radius * (1.5 + 20.0 * s.next_f32());
+            let emitter = Emitter::Sphere { sphere: 0, center, radius, cap: EmitterCap::WHOLE };
+            // On the edge, or a hair inside it
+            let u = Vec2::new(if k % 2 == 0 { 1.0 } else { 1.0 - f32::EPSILON }, s.next_f32());
+            let Some((point, normal, _, pdf)) = sample_area(&emitter, p, u) else { continue };
+            assert!(pdf > 0.0 && pdf.is_finite());
+            assert!((normal - (point - center) / radius).length() < 1e-4, "normal {normal} at {point}");
+            assert!(normal.dot(p - point) > -1e-3 * (p - point).length(), "a sample facing away from {p}");
+            // The ray the sample was drawn along, as `sample_area` draws it
+            let (to_center, distance2) = (center - p, (center - p).length_squared());
+            let sin2_max = radius * radius / distance2;
+            let one_minus_cos = sin2_max / (1.0 + (1.0 - sin2_max).sqrt());
+            let frame = Frame::from_z(to_center / distance2.sqrt());
+            let ray = Ray::new(p, frame.to_world(uniform_cone(u, one_minus_cos)));
+            if crate::geometry::intersect_sphere(&ray, center, radius, f32::INFINITY).is_none() {
+                missed += 1;
+                let along = (point - p).dot(ray.direction);
+                assert!((ray.at(along) - point).length() < 1e-4 * (1.0 + (p - center).length()), "{point} off the ray");
+            }
+        }
+        assert!(missed > 0, "no edge ray missed: the fallback was not exercised");
+    }
+
     #[test]
     fn spot_cone_edge_is_where_cos_says() {
         let axis = -Vec3::Y;
