@@ -210,14 +210,17 @@ fn rendering_pauses_while_minimised_and_resumes_after() {
     };
     minimise(&mut harness, true);
     assert!(harness.state().is_paused());
-    // No pass arrives while paused (an unlimited render would add several
-    // a frame at 64×48)
+    // At most the pass whose tiles were done when the pause came lands
+    // after it (its event may still be on its way); no other (an unlimited
+    // render would add several a frame at 64×48)
     let passes = harness.state().panes().list()[0].state().passes();
     for _ in 0..50 {
         harness.step();
         std::thread::sleep(std::time::Duration::from_millis(4));
     }
-    assert_eq!(harness.state().panes().list()[0].state().passes(), passes, "passes arrived while paused");
+    let after = harness.state().panes().list()[0].state().passes();
+    assert!(after <= passes + 1, "{} passes arrived while paused", after - passes);
+    let passes = after;
     let generation = harness.state().panes().generations()[0];
     minimise(&mut harness, false);
     assert!(!harness.state().is_paused());
