@@ -314,4 +314,6 @@ fn the_light_picker_picks_by_power_and_never_from_nothing() {
     assert_eq!(two.probability(2), 0.0, "a light past the last");
     assert_eq!(two.pick(0.1).map(|(i, _)| i), Some(0));
     assert_eq!(two.pick(0.9).map(|(i, _)| i), Some(1));
+    // A u rounded up to 1 (past every cumulative power) still picks the last light
+    assert_eq!(two.pick(1.0).map(|(i, _)| i), Some(1));
 }
