@@ -317,3 +317,82 @@ fn the_light_picker_picks_by_power_and_never_from_nothing() {
     // A u rounded up to 1 (past every cumulative power) still picks the last light
     assert_eq!(two.pick(1.0).map(|(i, _)| i), Some(1));
 }
+
+/// Caustic photons from a directional light leave a disc that just covers
+/// the glass sphere they are aimed at, along the light: every ray passes
+/// within the sphere's radius of its centre, the disc is covered uniformly
+/// (E[ρ²] = r²/2; 5σ with σ² = r⁴/12/n), and every photon carries the same
+/// finite power (one target, one light: the density of origins is the
+/// same everywhere on the disc).
+#[test]
+fn directional_caustic_photons_leave_a_disc_covering_their_target() {
+    use gi_studio::render::integrators::photon_map::emit::{emit_toward, specular_targets, LightPicker};
+    let (center, radius) = (Vec3::new(0.3, 0.5, -0.2), 0.3);
+    let objects = vec![
+        object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor"),
+        object("ball", Shape::Sphere { center, radius }, "glass"),
+    ];
+    let materials =
+        vec![material("floor", lambert(0.5)), material("glass", MaterialModel::Glass { ior: 1.5, tint: Vec3::ONE })];
+    let direction = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let sun = light("sun", gi_studio::scene::LightKind::Directional { direction }, 2.0);
+    let world = World::new(&valid(scene(camera(Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO), materials, objects, vec![sun])));
+    let (picker, targets) = (LightPicker::new(&world), specular_targets(&world));
+    assert_eq!(targets.len(), 1);
+    let mut s = Sampler::new(0, 0, 164);
+    let (n, mut rho2_sum, mut first_power) = (20_000, 0.0f64, None);
+    for _ in 0..n {
+        let photon = emit_toward(&world, &picker, &targets, &mut s).expect("a photon toward the ball");
+        assert!((photon.ray.direction - direction).length() < 1e-6, "along the light");
+        let offset = center - photon.ray.origin;
+        let rho2 = (offset - direction * offset.dot(direction)).length_squared();
+        assert!(rho2 <= radius * radius * (1.0 + 1e-4), "a ray passing {} from the centre", rho2.sqrt());
+        rho2_sum += (rho2 / (radius * radius)) as f64;
+        let power = photon.power;
+        assert!(power.is_finite() && power.min_element() > 0.0, "power {power}");
+        let first = *first_power.get_or_insert(power);
+        assert!((power - first).abs().max_element() <= 1e-5 * first.max_element(), "{power} against {first}");
+    }
+    let mean = rho2_sum / n as f64;
+    let sigma = (1.0 / 12.0 / n as f64).sqrt();
+    assert!((mean - 0.5).abs() < 5.0 * sigma, "E[ρ²]/r² = {mean}, σ {sigma}");
+}
+
+/// Caustic photons from a spot light (falloff exponent 0, its cone wider
+/// than the ball) are aimed into the cone the ball subtends, uniformly, so
+/// each carries the intensity times that cone's solid angle,
+/// 2π(1 − cos θ), the inverse of the direction's pdf.
+#[test]
+fn spot_caustic_photons_carry_intensity_times_the_cone() {
+    use gi_studio::render::integrators::photon_map::emit::{emit_toward, specular_targets, LightPicker};
+    let (center, radius, position) = (Vec3::new(0.0, 0.5, 0.0), 0.3, Vec3::new(0.2, 2.5, 0.1));
+    let objects = vec![
+        object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor"),
+        object("ball", Shape::Sphere { center, radius }, "glass"),
+    ];
+    let materials =
+        vec![material("floor", lambert(0.5)), material("glass", MaterialModel::Glass { ior: 1.5, tint: Vec3::ONE })];
+    let kind = gi_studio::scene::LightKind::Spot {
+        position,
+        direction: -Vec3::Y,
+        cone_angle_degrees: 60.0,
+        falloff_exponent: 0.0,
+    };
+    let spot = light("spot", kind, 3.0);
+    let world = World::new(&valid(scene(camera(Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO), materials, objects, vec![spot])));
+    let (picker, targets) = (LightPicker::new(&world), specular_targets(&world));
+    let distance2 = (center - position).length_squared() as f64;
+    let sin2 = (radius * radius) as f64 / distance2;
+    let cone = 2.0 * std::f64::consts::PI * (1.0 - (1.0 - sin2).sqrt());
+    let mut s = Sampler::new(0, 0, 171);
+    for _ in 0..2000 {
+        let photon = emit_toward(&world, &picker, &targets, &mut s).expect("a photon toward the ball");
+        assert!(
+            intersect_sphere(&photon.ray, center, radius, f32::INFINITY).is_some(),
+            "a photon that misses the ball"
+        );
+        let expected = 3.0 * cone;
+        let power = photon.power.max_element() as f64;
+        assert!((power - expected).abs() < 1e-4 * expected, "power {power} against {expected}");
+    }
+}
