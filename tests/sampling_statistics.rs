@@ -318,6 +318,27 @@ fn the_light_picker_picks_by_power_and_never_from_nothing() {
     assert_eq!(two.pick(1.0).map(|(i, _)| i), Some(1));
 }
 
+/// A glass ball of `radius` at `center` over a floor, lit by `light` alone:
+/// the world, its light picker and its caustic targets.
+fn glass_ball_under(
+    center: Vec3,
+    radius: f32,
+    light: gi_studio::scene::Light,
+) -> (World, gi_studio::render::integrators::photon_map::emit::LightPicker, Vec<(Vec3, f32)>) {
+    use gi_studio::render::integrators::photon_map::emit::{specular_targets, LightPicker};
+    let objects = vec![
+        object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor"),
+        object("ball", Shape::Sphere { center, radius }, "glass"),
+    ];
+    let glass = MaterialModel::Glass { ior: 1.5, tint: Vec3::ONE };
+    let materials = vec![material("floor", lambert(0.5)), material("glass", glass)];
+    let eye = camera(Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO);
+    let world = World::new(&valid(scene(eye, materials, objects, vec![light])));
+    let (picker, targets) = (LightPicker::new(&world), specular_targets(&world));
+    assert_eq!(targets.len(), 1, "the ball is the one caustic target");
+    (world, picker, targets)
+}
+
 /// Caustic photons from a directional light leave a disc that just covers
 /// the glass sphere they are aimed at, along the light: every ray passes
 /// within the sphere's radius of its centre, the disc is covered uniformly
@@ -326,19 +347,11 @@ fn the_light_picker_picks_by_power_and_never_from_nothing() {
 /// same everywhere on the disc).
 #[test]
 fn directional_caustic_photons_leave_a_disc_covering_their_target() {
-    use gi_studio::render::integrators::photon_map::emit::{emit_toward, specular_targets, LightPicker};
+    use gi_studio::render::integrators::photon_map::emit::emit_toward;
     let (center, radius) = (Vec3::new(0.3, 0.5, -0.2), 0.3);
-    let objects = vec![
-        object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor"),
-        object("ball", Shape::Sphere { center, radius }, "glass"),
-    ];
-    let materials =
-        vec![material("floor", lambert(0.5)), material("glass", MaterialModel::Glass { ior: 1.5, tint: Vec3::ONE })];
     let direction = Vec3::new(0.3, -1.0, 0.2).normalize();
     let sun = light("sun", gi_studio::scene::LightKind::Directional { direction }, 2.0);
-    let world = World::new(&valid(scene(camera(Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO), materials, objects, vec![sun])));
-    let (picker, targets) = (LightPicker::new(&world), specular_targets(&world));
-    assert_eq!(targets.len(), 1);
+    let (world, picker, targets) = glass_ball_under(center, radius, sun);
     let mut s = Sampler::new(0, 0, 164);
     let (n, mut rho2_sum, mut first_power) = (20_000, 0.0f64, None);
     for _ in 0..n {
@@ -364,23 +377,15 @@ fn directional_caustic_photons_leave_a_disc_covering_their_target() {
 /// 2π(1 − cos θ), the inverse of the direction's pdf.
 #[test]
 fn spot_caustic_photons_carry_intensity_times_the_cone() {
-    use gi_studio::render::integrators::photon_map::emit::{emit_toward, specular_targets, LightPicker};
+    use gi_studio::render::integrators::photon_map::emit::emit_toward;
     let (center, radius, position) = (Vec3::new(0.0, 0.5, 0.0), 0.3, Vec3::new(0.2, 2.5, 0.1));
-    let objects = vec![
-        object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor"),
-        object("ball", Shape::Sphere { center, radius }, "glass"),
-    ];
-    let materials =
-        vec![material("floor", lambert(0.5)), material("glass", MaterialModel::Glass { ior: 1.5, tint: Vec3::ONE })];
     let kind = gi_studio::scene::LightKind::Spot {
         position,
         direction: -Vec3::Y,
         cone_angle_degrees: 60.0,
         falloff_exponent: 0.0,
     };
-    let spot = light("spot", kind, 3.0);
-    let world = World::new(&valid(scene(camera(Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO), materials, objects, vec![spot])));
-    let (picker, targets) = (LightPicker::new(&world), specular_targets(&world));
+    let (world, picker, targets) = glass_ball_under(center, radius, light("spot", kind, 3.0));
     let distance2 = (center - position).length_squared() as f64;
     let sin2 = (radius * radius) as f64 / distance2;
     let cone = 2.0 * std::f64::consts::PI * (1.0 - (1.0 - sin2).sqrt());
