@@ -100,3 +100,28 @@ fn degenerate_sets() {
     assert!(tree_result(&tree, Vec3::splat(0.5), Some(-Vec3::Y), 50, 1.0).is_empty());
     assert_eq!(tree_result(&tree, Vec3::splat(0.5), Some(Vec3::Y), 50, 1.0).len(), 50);
 }
+
+/// Photons on a whole grid, gathered at every grid point with radii that are
+/// grid distances: neighbours lie exactly on the bound, and many of them on
+/// a split plane, in a subtree deferred at exactly the bound's distance. A
+/// photon on the bound is in (≤), as in the brute-force scan.
+#[test]
+fn photons_exactly_at_the_gather_radius_are_found() {
+    let grid = |n: i32| (0..n).flat_map(move |x| (0..n).flat_map(move |y| (0..n).map(move |z| (x, y, z))));
+    let photons: Vec<Photon> = grid(5).map(|(x, y, z)| photon((x as f32, y as f32, z as f32), false)).collect();
+    let tree = PhotonKdTree::build(photons.clone());
+    for (x, y, z) in grid(5) {
+        let q = Vec3::new(x as f32, y as f32, z as f32);
+        for radius in [1.0, 2.0_f32.sqrt(), 2.0] {
+            // k above what the radius holds: the bound stays the radius
+            assert_eq!(
+                tree_result(&tree, q, None, 60, radius),
+                brute_force(&photons, q, None, 60, radius),
+                "at {q}, r {radius}"
+            );
+            let mut found = 0;
+            tree.for_each_within(q, radius, |_| found += 1);
+            assert_eq!(found, brute_force(&photons, q, None, usize::MAX, radius).len(), "at {q}, r {radius}");
+        }
+    }
+}

@@ -282,4 +282,74 @@ mod tests {
         assert_ne!(sum(&data[..76]), whole);
         assert_ne!(sum(&[data.as_slice(), &[0]].concat()), whole);
     }
+
+    fn maps_of(global: usize, caustic: usize) -> PhotonMaps {
+        let photons = |n: usize, z: f32| -> Vec<Photon> {
+            (0..n).map(|i| Photon::new(glam::Vec3::new(i as f32, 0.5, z), -glam::Vec3::Y, [1.0; 3])).collect()
+        };
+        PhotonMaps {
+            global: PhotonKdTree::build(photons(global, 0.0)),
+            caustic: PhotonKdTree::build(photons(caustic, 1.0)),
+            stats: PhotonMapStats {
+                global: MapStats { emitted: 50, ..MapStats::default() },
+                caustic: MapStats { emitted: 40, ..MapStats::default() },
+            },
+            max_radius: 0.5,
+        }
+    }
+
+    /// The sizes the reader trusts are the writer's: a saved file is its
+    /// header, two map headers, the records and the checksum; and what is
+    /// read back says how deep each tree is.
+    #[test]
+    fn the_layout_the_reader_expects_is_the_one_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("maps.photons");
+        save_photon_maps(&maps_of(5, 3), 1, 2, &path).unwrap();
+        let size = std::fs::metadata(&path).unwrap().len();
+        assert_eq!(size, HEADER_BYTES + 2 * MAP_HEADER_BYTES + 8 * PHOTON_BYTES + 8);
+        assert_eq!((HEADER_BYTES, MAP_HEADER_BYTES, PHOTON_BYTES), (32, 16, 28));
+        let loaded = load_photon_maps(&path, 1, 2).unwrap();
+        assert_eq!((loaded.global.len(), loaded.caustic.len()), (5, 3));
+        assert_eq!((loaded.stats.global.depth, loaded.stats.caustic.depth), (3, 2));
+        assert_eq!((loaded.stats.global.bytes, loaded.stats.caustic.stored), (5 * 28, 3));
+        assert_eq!((loaded.stats.global.emitted, loaded.stats.caustic.emitted, loaded.max_radius), (50, 40, 0.5));
+    }
+
+    /// The largest file opened is the largest two full maps need (2 × 200 M
+    /// records); one byte more is refused before a byte is read. Sparse
+    /// files: nothing is written to the disk.
+    #[test]
+    fn files_up_to_two_full_maps_are_opened_and_larger_ones_refused() {
+        const TWO_FULL_MAPS: u64 = 32 + 2 * (16 + 200_000_000 * 28) + 8;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.photons");
+        let file = std::fs::File::create(&path).unwrap();
+        file.set_len(TWO_FULL_MAPS).unwrap();
+        // Opened and read: zeros are not a photon map
+        assert!(matches!(load_photon_maps(&path, 1, 2), Err(PhotonFileError::NotAPhotonMap { .. })));
+        file.set_len(TWO_FULL_MAPS + 1).unwrap();
+        let refused = load_photon_maps(&path, 1, 2);
+        assert!(
+            matches!(refused, Err(PhotonFileError::File(FileError::TooLarge { max: TWO_FULL_MAPS, .. }))),
+            "{refused:?}"
+        );
+    }
+
+    /// A count larger than the rest of the file is refused as such, before
+    /// anything is allocated for it, even when it is only a little larger.
+    #[test]
+    fn a_map_claiming_more_photons_than_the_file_holds_is_refused_before_allocating() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("maps.photons");
+        save_photon_maps(&maps_of(5, 3), 1, 2, &path).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        // After the global map's count, 248 bytes are left: room for 8 records
+        let count_at = (HEADER_BYTES + 8) as usize;
+        assert_eq!(bytes.len() - count_at - 8, 248);
+        bytes[count_at..count_at + 8].copy_from_slice(&9u64.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let refused = load_photon_maps(&path, 1, 2).unwrap_err().to_string();
+        assert!(refused.contains("the global map claims 9 photons, more than the file holds"), "{refused}");
+    }
 }

@@ -177,3 +177,74 @@ pub fn estimate(
     stats.time += start.elapsed();
     sum
 }
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::PI as PI64;
+
+    use super::*;
+    use crate::render::integrators::photon_map::record::Photon;
+
+    #[test]
+    fn query_stats_add_every_field_and_average_per_query() {
+        let mut histogram = [0; RADIUS_BINS];
+        histogram[3] = 2;
+        let a =
+            QueryStats { queries: 4, nodes_visited: 100, time: Duration::from_micros(40), radius_histogram: histogram };
+        let mut sum = QueryStats { queries: 1, nodes_visited: 7, time: Duration::from_micros(2), ..Default::default() };
+        sum.radius_histogram[0] = 1;
+        sum.add(&a);
+        sum.add(&a);
+        assert_eq!((sum.queries, sum.nodes_visited, sum.time), (9, 207, Duration::from_micros(82)));
+        assert_eq!((sum.radius_histogram[0], sum.radius_histogram[3]), (1, 4));
+        assert_eq!(sum.mean_nodes_visited(), 23.0);
+        assert_eq!(sum.mean_query_time(), Duration::from_nanos(82_000 / 9));
+        // No query yet: nothing to divide
+        assert_eq!(
+            (QueryStats::default().mean_nodes_visited(), QueryStats::default().mean_query_time()),
+            (0.0, Duration::ZERO)
+        );
+    }
+
+    #[test]
+    fn a_radius_in_the_settings_is_taken_and_none_is_a_twentieth_of_the_view() {
+        let settings = |max_radius| PhotonSettings { max_radius, ..PhotonSettings::default() };
+        assert_eq!(resolve_max_radius(10.0, &settings(0.3)), 0.3);
+        assert_eq!(resolve_max_radius(10.0, &settings(0.0)), 0.5);
+    }
+
+    /// Photons from straight above at 1, 2, …, 20 along x, of power 2 each,
+    /// gathered at the origin of a Lambert floor: Σ f Φ / (π r²) over the
+    /// k nearest, r the k-th's distance, or the largest radius when fewer
+    /// lie within it; each query counted, with its nodes and its radius's bin.
+    #[test]
+    fn the_estimate_is_the_density_of_the_nearest_photons_and_is_counted() {
+        let photons = (1..=20).map(|d| Photon::new(Vec3::new(d as f32, 0.0, 0.0), -Vec3::Y, [2.0; 3])).collect();
+        let tree = PhotonKdTree::build(photons);
+        let albedo = 0.6;
+        let bsdf = Bsdf::Lambert { albedo: Rgb::splat(albedo) };
+        let (mut neighbours, mut stats) = (Neighbours::new(8), QueryStats::default());
+        let mut gather = |k, max_radius, stats: &mut QueryStats| {
+            let value = estimate(&tree, Vec3::ZERO, Vec3::Y, Vec3::Y, &bsdf, k, max_radius, &mut neighbours, stats);
+            (value, neighbours.len())
+        };
+        let expected = |found: f64, radius: f64| (albedo as f64 / PI64) * found * 2.0 / (PI64 * radius * radius);
+        // k = 8 within 20: the 8th photon is at 8, in bin ⌊8/20·16⌋ = 6
+        let (value, found) = gather(8, 20.0, &mut stats);
+        assert_eq!(found, 8);
+        assert!((value.x as f64 / expected(8.0, 8.0) - 1.0).abs() < 1e-5, "{value}");
+        assert_eq!(value.x, value.z);
+        // Only 5 within 5.5: all of them over the whole disc, in the last bin
+        let (value, found) = gather(8, 5.5, &mut stats);
+        assert_eq!(found, 5);
+        assert!((value.x as f64 / expected(5.0, 5.5) - 1.0).abs() < 1e-5, "{value}");
+        let mut bins = [0; RADIUS_BINS];
+        bins[6] = 1;
+        bins[RADIUS_BINS - 1] = 1;
+        assert_eq!((stats.queries, stats.radius_histogram), (2, bins));
+        let mut out = Neighbours::new(8);
+        let visited = tree.k_nearest(Vec3::ZERO, Some(Vec3::Y), 8, 20.0, &mut out)
+            + tree.k_nearest(Vec3::ZERO, Some(Vec3::Y), 8, 5.5, &mut out);
+        assert_eq!(stats.nodes_visited, visited as u64);
+    }
+}
