@@ -20,7 +20,7 @@ use gi_studio::render::world::World;
 use gi_studio::render::{
     render_blocking, Algorithm, LinearImage, RenderEvent, RenderJob, RenderSession, RenderSettings,
 };
-use gi_studio::scene::{presets, LightKind, Scene};
+use gi_studio::scene::{presets, LightKind, Scene, Shape};
 use glam::Vec3;
 
 fn settings(algorithm: Algorithm, width: u32, height: u32, spp: u32) -> RenderSettings {
@@ -85,19 +85,33 @@ fn assert_same_energy(image: &LinearImage, reference: &LinearImage, what: &str, 
     assert!(deviation.abs() < tolerance, "{what}: mean {mean:.5} against path tracing's {expected:.5}");
 }
 
+/// Final gathering on the diffuse Cornell box, and on the same box with its
+/// walls' planes turned to face out: then every wall is met from behind,
+/// and must be lit, and gathered from, on the side it is met (surfaces are
+/// two-sided), so both agree with path tracing of the box.
 #[test]
 fn final_gathering_agrees_with_converged_path_tracing_too() {
     let scene = detectors::diffuse_cornell();
     let reference = render(&scene, settings(Algorithm::Path, 40, 30, 2048));
-    let mut photon = settings(Algorithm::Photon, 40, 30, 16);
-    let p = photon.photon_mut().unwrap();
-    p.global_photons = 200_000;
-    p.final_gather = true;
-    p.final_gather_rays = 16;
-    let image = render(&scene, photon);
-    let error = rel_mse(&image, &reference, RelMseOptions::default()).unwrap();
-    assert!(error < 0.02, "relMSE {error}");
-    assert_same_energy(&image, &reference, "final gathering", 0.005);
+    let mut walls_facing_out = scene.clone();
+    for object in &mut walls_facing_out.objects {
+        if let Shape::Plane { normal, .. } = &mut object.shape {
+            *normal = -*normal;
+        }
+    }
+    let planes = |scene: &Scene| scene.objects.iter().filter(|o| matches!(o.shape, Shape::Plane { .. })).count();
+    assert_eq!(planes(&walls_facing_out), 5);
+    for (what, scene) in [("final gathering", &scene), ("final gathering, walls facing out", &walls_facing_out)] {
+        let mut photon = settings(Algorithm::Photon, 40, 30, 16);
+        let p = photon.photon_mut().unwrap();
+        p.global_photons = 200_000;
+        p.final_gather = true;
+        p.final_gather_rays = 16;
+        let image = render(scene, photon);
+        let error = rel_mse(&image, &reference, RelMseOptions::default()).unwrap();
+        assert!(error < 0.02, "{what}: relMSE {error}");
+        assert_same_energy(&image, &reference, what, 0.005);
+    }
 }
 
 /// relMSE of SPPM on the caustics preset after 8 and after 64 passes
