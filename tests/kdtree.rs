@@ -95,6 +95,11 @@ fn degenerate_sets() {
     assert_eq!(found, vec![0.0; 50]);
     // A radius that excludes everything
     assert!(tree_result(&tree, Vec3::splat(5.0), None, 50, 1.0).is_empty());
+    // A negative radius holds nothing, not what its square would
+    assert!(tree_result(&tree, Vec3::splat(0.5), None, 50, -1.0).is_empty());
+    let mut found = 0;
+    tree.for_each_within(Vec3::splat(0.5), -1.0, |_| found += 1);
+    assert_eq!(found, 0);
     // Photons from behind the surface are skipped: all travel down (-y), so a
     // surface facing down sees none of them
     assert!(tree_result(&tree, Vec3::splat(0.5), Some(-Vec3::Y), 50, 1.0).is_empty());

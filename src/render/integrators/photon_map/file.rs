@@ -314,6 +314,10 @@ mod tests {
         assert_eq!((loaded.stats.global.depth, loaded.stats.caustic.depth), (3, 2));
         assert_eq!((loaded.stats.global.bytes, loaded.stats.caustic.stored), (5 * 28, 3));
         assert_eq!((loaded.stats.global.emitted, loaded.stats.caustic.emitted, loaded.max_radius), (50, 40, 0.5));
+        // A map with no photons (a scene with nothing specular has no caustics)
+        save_photon_maps(&maps_of(4, 0), 1, 2, &path).unwrap();
+        let loaded = load_photon_maps(&path, 1, 2).unwrap();
+        assert_eq!((loaded.global.len(), loaded.caustic.len()), (4, 0));
     }
 
     /// The largest file opened is the largest two full maps need (2 × 200 M
