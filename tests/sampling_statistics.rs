@@ -389,6 +389,7 @@ fn spot_caustic_photons_carry_intensity_times_the_cone() {
     let distance2 = (center - position).length_squared() as f64;
     let sin2 = (radius * radius) as f64 / distance2;
     let cone = 2.0 * std::f64::consts::PI * (1.0 - (1.0 - sin2).sqrt());
+    let expected = 3.0 * cone;
     let mut s = Sampler::new(0, 0, 171);
     for _ in 0..2000 {
         let photon = emit_toward(&world, &picker, &targets, &mut s).expect("a photon toward the ball");
@@ -396,7 +397,6 @@ fn spot_caustic_photons_carry_intensity_times_the_cone() {
             intersect_sphere(&photon.ray, center, radius, f32::INFINITY).is_some(),
             "a photon that misses the ball"
         );
-        let expected = 3.0 * cone;
         let power = photon.power.max_element() as f64;
         assert!((power - expected).abs() < 1e-4 * expected, "power {power} against {expected}");
     }
