@@ -111,34 +111,57 @@ fn watertight(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<SurfaceHit> 
 /// scaled), and the scale `sz` for z.
 #[inline(always)]
 pub fn shear_of<R: Real>(origin: V3<R>, direction: V3<R>, vertices: [V3<R>; 3]) -> ([V3<R>; 3], R) {
+    ray_shear_of(origin, direction).vertices(vertices)
+}
+
+/// The ray's part of `shear_of`, the same for every triangle it is tested
+/// against: its direction's largest axis and the shear.
+#[derive(Clone, Copy)]
+pub struct RayShear<R: Real> {
+    y_largest: R::Mask,
+    z_largest: R::Mask,
+    /// The origin, permuted.
+    origin: V3<R>,
+    sx: R,
+    sy: R,
+    sz: R,
+}
+
+/// Permuted so that z is the largest axis: a selection, so permuting a
+/// difference is the difference of the permuted (bit for bit).
+/// Functions, not closures: a closure is left out of line, without AVX2.
+#[inline(always)]
+fn permute<R: Real>(v: V3<R>, y_largest: R::Mask, z_largest: R::Mask) -> V3<R> {
+    V3::new(
+        R::select(z_largest, v.x, R::select(y_largest, v.z, v.y)),
+        R::select(z_largest, v.y, R::select(y_largest, v.x, v.z)),
+        R::select(z_largest, v.z, R::select(y_largest, v.y, v.x)),
+    )
+}
+
+#[inline(always)]
+pub fn ray_shear_of<R: Real>(origin: V3<R>, direction: V3<R>) -> RayShear<R> {
     // glam's `max_position` of |d| (the first largest), as selects
     let a = direction.abs();
     let y_largest = a.y.gt(a.x);
     let z_largest = a.z.gt(R::select(y_largest, a.y, a.x));
-    // Functions, not closures: a closure is left out of line, without AVX2
-    #[inline(always)]
-    fn permute<R: Real>(v: V3<R>, y_largest: R::Mask, z_largest: R::Mask) -> V3<R> {
-        V3::new(
-            R::select(z_largest, v.x, R::select(y_largest, v.z, v.y)),
-            R::select(z_largest, v.y, R::select(y_largest, v.x, v.z)),
-            R::select(z_largest, v.z, R::select(y_largest, v.y, v.x)),
-        )
-    }
-    #[inline(always)]
-    fn shear<R: Real>(p: V3<R>, sx: R, sy: R) -> V3<R> {
-        V3::new(p.x + sx * p.z, p.y + sy * p.z, p.z)
-    }
     let d = permute(direction, y_largest, z_largest);
     let sz = R::splat(1.0) / d.z;
-    let sx = -d.x * sz;
-    let sy = -d.y * sz;
-    let [p0, p1, p2] = vertices;
-    let sheared = [
-        shear(permute(p0 - origin, y_largest, z_largest), sx, sy),
-        shear(permute(p1 - origin, y_largest, z_largest), sx, sy),
-        shear(permute(p2 - origin, y_largest, z_largest), sx, sy),
-    ];
-    (sheared, sz)
+    RayShear { y_largest, z_largest, origin: permute(origin, y_largest, z_largest), sx: -d.x * sz, sy: -d.y * sz, sz }
+}
+
+impl<R: Real> RayShear<R> {
+    /// A triangle's vertices in the ray's sheared space, and the scale of z.
+    #[inline(always)]
+    pub fn vertices(&self, [p0, p1, p2]: [V3<R>; 3]) -> ([V3<R>; 3], R) {
+        ([self.vertex(p0), self.vertex(p1), self.vertex(p2)], self.sz)
+    }
+
+    #[inline(always)]
+    fn vertex(&self, p: V3<R>) -> V3<R> {
+        let p = permute(p, self.y_largest, self.z_largest) - self.origin;
+        V3::new(p.x + self.sx * p.z, p.y + self.sy * p.z, p.z)
+    }
 }
 
 /// The edge functions of the sheared vertices; where one is exactly zero

@@ -11,7 +11,7 @@
 
 use glam::{DVec3, Vec3};
 
-use super::lanes::{F8, LANES, M8, V8};
+use super::lanes::{F8, M8, V8};
 use super::light::{Emitter, LightSample, LightSource};
 use super::shapes::{PlaneShape, Spheres};
 use super::spheres::SphereLanes;
@@ -213,7 +213,7 @@ impl Walls {
             }
         }
         let mut held = !out;
-        for lane in (0..LANES).filter(|&i| !out.test(i) && unsure.test(i)) {
+        for lane in unsure.and_not(out).lanes() {
             held.set(lane, self.hold(origins.lane(lane)));
         }
         held
@@ -302,6 +302,7 @@ mod tests {
     use super::*;
     use crate::geometry::{intersect_triangle, sphere_t, Ray};
     use crate::render::world::camera::CameraModel;
+    use crate::render::world::lanes::LANES;
     use crate::render::world::rng::Sampler;
     use crate::render::world::sampling::uniform_sphere;
     use crate::render::world::World;

@@ -432,7 +432,7 @@ impl LightLanes {
             in_lanes = in_lanes.or(lanes);
         }
         let others = mask.and_not(in_lanes);
-        for lane in (0..LANES).filter(|&i| others.test(i)) {
+        for lane in others.lanes() {
             let light = &world.lights[pick[lane]];
             let u = Vec2::new(u.0.lane(lane), u.1.lane(lane));
             if let Some(sample) = light.sample(&hit(lane), u) {

@@ -26,7 +26,7 @@ use samples::{CameraSample, CameraSamples};
 use super::Counters;
 use crate::faults::{self, Fault};
 use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
-use crate::geometry::{edges_of, shear_of, triangle_hit_of, watertight_hit_of};
+use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_hit_of, RayShear};
 use crate::geometry::{frame_from_z, gamma, intersect_triangle, offset_origin, to_world, Ray, SurfaceHit, Triangle};
 use crate::geometry::{may_reach_of, plane_exit_of, plane_point_of, plane_t_of};
 use crate::render::world::bsdf::{blinn_normalisation, reflect_of, refraction_of, Bsdf, Refraction};
@@ -381,12 +381,13 @@ impl PathLanes {
         let first_triangle = first_plane + self.planes.len() as f32;
         let (mut triangle_point, mut triangle_normal, mut triangle_error) =
             (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
+        let shear = ray_shear_of(origin, direction);
         for (j, triangle) in self.triangles.iter().enumerate() {
             let near = self.may_reach(j, active, origin, direction, t_hit);
             if !near.any() {
                 continue;
             }
-            let (hits, t, point, error) = Self::triangle_hits(triangle, near, origin, direction, t_hit);
+            let (hits, t, point, error) = Self::triangle_hits(triangle, near, origin, direction, &shear, t_hit);
             if hits.any() {
                 t_hit = hits.select(t, t_hit);
                 index = hits.select(F8::splat(first_triangle + j as f32), index);
@@ -453,7 +454,7 @@ impl PathLanes {
 
         // Emission reached by this ray, weighted against light sampling (rare: lane by lane)
         let glowing = emissive.and(normal.dot(wo).gt(F8::splat(0.0))).and(color.nonzero());
-        for lane in (0..LANES).filter(|&i| glowing.test(i)) {
+        for lane in glowing.lanes() {
             let object = surface[lane].object;
             let weight = match world.objects[object as usize].light {
                 Some(light) if !st.after_delta.test(lane) => power_heuristic(
@@ -627,10 +628,17 @@ impl PathLanes {
     /// Lanes on an edge, where the scalar code redoes the edge functions in
     /// f64, take the scalar code.
     #[inline(always)]
-    fn triangle_hits(triangle: &Triangle, near: M8, origin: V8, direction: V8, t_max: F8) -> (M8, F8, V8, F8) {
+    fn triangle_hits(
+        triangle: &Triangle,
+        near: M8,
+        origin: V8,
+        direction: V8,
+        shear: &RayShear<F8>,
+        t_max: F8,
+    ) -> (M8, F8, V8, F8) {
         let [a, b, c] = triangle.vertices;
         let vertices = [V8::splat(a), V8::splat(b), V8::splat(c)];
-        let (sheared, sz) = shear_of(origin, direction, vertices);
+        let (sheared, sz) = shear.vertices(vertices);
         let edges = edges_of(sheared);
         let zero = F8::splat(0.0);
         let on_edge = near.and(edges[0].eq(zero).or(edges[1].eq(zero)).or(edges[2].eq(zero)));
@@ -640,7 +648,7 @@ impl PathLanes {
             true => triangle_hit_of(vertices, barycentrics),
             false => (V8::splat(Vec3::ZERO), zero),
         };
-        for lane in (0..LANES).filter(|&i| on_edge.test(i)) {
+        for lane in on_edge.lanes() {
             let ray = Ray::new(origin.lane(lane), direction.lane(lane));
             if let Some(hit) = intersect_triangle(&ray, triangle, t_max.lane(lane)) {
                 hits.set(lane, true);
@@ -700,11 +708,16 @@ impl PathLanes {
         }
         // Triangles where the ray may reach them, but those in
         // the plane of the light's own triangle (`Occluders::blocks`)
+        let shear = ray_shear_of(origin, direction);
+        let light_plane: [Option<u32>; LANES] = lanes::each(|i| self.light_planes[pick[i]]);
+        let any_light_plane = light_plane.iter().any(Option::is_some);
         for (j, (triangle, plane)) in self.triangles.iter().zip(&self.triangle_planes).enumerate() {
-            let near = self.may_reach(j, mask.and_not(blocked), origin, direction, t_max);
-            let near = near.and_not(M8::from_fn(|i| self.light_planes[pick[i]] == Some(*plane)));
+            let mut near = self.may_reach(j, mask.and_not(blocked), origin, direction, t_max);
+            if any_light_plane {
+                near = near.and_not(M8::from_fn(|i| light_plane[i] == Some(*plane)));
+            }
             if near.any() {
-                blocked = blocked.or(Self::triangle_hits(triangle, near, origin, direction, t_max).0);
+                blocked = blocked.or(Self::triangle_hits(triangle, near, origin, direction, &shear, t_max).0);
             }
         }
         mask.and(blocked)
@@ -807,6 +820,7 @@ impl Lanes {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::shear_of;
     use crate::render::world::camera::{CameraModel, TileRect};
     use crate::render::world::rng::PassStreams;
 
@@ -862,7 +876,9 @@ mod tests {
                 let direction = V8::from_fn(|i| batch[i].1);
                 let t_max = F8::from_fn(|i| batch[i].2);
                 let near = may_reach_of(origin, direction, V8::splat(center), F8::splat(radius), t_max);
-                let (hits, t, point, error) = PathLanes::triangle_hits(triangle, near, origin, direction, t_max);
+                let shear = ray_shear_of(origin, direction);
+                let (hits, t, point, error) =
+                    PathLanes::triangle_hits(triangle, near, origin, direction, &shear, t_max);
                 for (i, &(o, d, t_max)) in batch.iter().enumerate() {
                     let vertices = triangle.vertices.map(crate::geometry::real::V3::from);
                     on_edges += edges_of(shear_of(o.into(), d.into(), vertices).0).contains(&0.0) as u32;

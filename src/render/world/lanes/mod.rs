@@ -101,6 +101,17 @@ impl M8 {
         self.bits() >> lane & 1 != 0
     }
 
+    /// The lanes set, in order: one mask read, then only those lanes.
+    #[inline(always)]
+    pub fn lanes(self) -> impl Iterator<Item = usize> {
+        let mut bits = self.bits();
+        std::iter::from_fn(move || {
+            let lane = bits.trailing_zeros() as usize;
+            bits &= bits.wrapping_sub(1);
+            (lane < LANES).then_some(lane)
+        })
+    }
+
     #[inline(always)]
     pub fn set(&mut self, lane: usize, value: bool) {
         let lanes = self.to_array();
@@ -354,6 +365,16 @@ mod tests {
                         || same(F8::splat(k).exp2_whole().lane(i), k.exp2_whole()) && k.exp2_whole() == 2f32.powf(k)
                 );
             }
+        }
+    }
+
+    /// `lanes` gives the set lanes of every mask, each once, in order.
+    #[test]
+    fn a_masks_lanes_are_its_set_bits_in_order() {
+        for bits in 0..1u32 << LANES {
+            let lanes: Vec<usize> = M8::from_bits(bits).lanes().collect();
+            let expected: Vec<usize> = (0..LANES).filter(|&i| bits >> i & 1 != 0).collect();
+            assert_eq!(lanes, expected, "{bits:#b}");
         }
     }
 
