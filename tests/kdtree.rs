@@ -84,9 +84,13 @@ fn degenerate_sets() {
     let q = Vec3::new(0.1, 0.2, 0.3);
     // n = 0
     let empty = PhotonKdTree::build(Vec::new());
+    assert!(empty.is_empty());
+    assert_eq!((empty.len(), empty.depth()), (0, 0));
     assert!(tree_result(&empty, q, None, 5, f32::INFINITY).is_empty());
     // n = 1, k > n
     let one = PhotonKdTree::build(vec![photon((1.0, 1.0, 1.0), true)]);
+    assert!(!one.is_empty());
+    assert_eq!((one.len(), one.depth()), (1, 1));
     assert_eq!(tree_result(&one, q, None, 5, f32::INFINITY).len(), 1);
     // All photons at one point: k of them at the same distance
     let same: Vec<Photon> = (0..1000).map(|_| photon((0.5, 0.5, 0.5), false)).collect();

@@ -132,6 +132,8 @@ pub fn save_photon_maps(
 struct Reader<'a> {
     input: std::io::BufReader<std::fs::File>,
     left: u64,
+    /// The most photons a map may hold (`limits::STORED_PHOTONS`).
+    most_photons: u64,
     sum: Checksum,
     path: &'a Path,
 }
@@ -168,7 +170,13 @@ impl Reader<'_> {
     fn map(&mut self, name: &str) -> Result<RawMap, PhotonFileError> {
         let emitted = self.u64()?;
         let count = self.u64()?;
-        if count > limits::STORED_PHOTONS || count * PHOTON_BYTES > self.left {
+        if count > self.most_photons {
+            let most = self.most_photons;
+            return Err(
+                self.damaged(format!("the {name} map claims {count} photons, more than the {most} a map may hold"))
+            );
+        }
+        if count * PHOTON_BYTES > self.left {
             return Err(self.damaged(format!("the {name} map claims {count} photons, more than the file holds")));
         }
         let mut records = vec![0u8; (count * PHOTON_BYTES) as usize];
@@ -211,10 +219,21 @@ impl RawMap {
 }
 
 pub fn load_photon_maps(path: &Path, scene_key: u64, settings_key: u64) -> Result<PhotonMaps, PhotonFileError> {
-    let most = HEADER_BYTES + 2 * (MAP_HEADER_BYTES + limits::STORED_PHOTONS * PHOTON_BYTES) + 8;
+    load_bounded(path, scene_key, settings_key, limits::STORED_PHOTONS)
+}
+
+/// `load_photon_maps` with maps of at most `most_photons` (a test can
+/// reach the bound without gigabytes).
+fn load_bounded(
+    path: &Path,
+    scene_key: u64,
+    settings_key: u64,
+    most_photons: u64,
+) -> Result<PhotonMaps, PhotonFileError> {
+    let most = HEADER_BYTES + 2 * (MAP_HEADER_BYTES + most_photons * PHOTON_BYTES) + 8;
     let file = fileio::open_regular(path, most)?;
     let left = file.metadata().map_err(|cause| FileError::Io { path: path.to_owned(), cause })?.len();
-    let mut input = Reader { input: std::io::BufReader::new(file), left, sum: Checksum::new(), path };
+    let mut input = Reader { input: std::io::BufReader::new(file), left, most_photons, sum: Checksum::new(), path };
     let not_ours = || PhotonFileError::NotAPhotonMap { path: path.to_owned() };
     let mut magic = [0u8; 8];
     input.bytes(&mut magic).map_err(|_| not_ours())?;
@@ -355,5 +374,18 @@ mod tests {
         std::fs::write(&path, &bytes).unwrap();
         let refused = load_photon_maps(&path, 1, 2).unwrap_err().to_string();
         assert!(refused.contains("the global map claims 9 photons, more than the file holds"), "{refused}");
+    }
+
+    /// A map of exactly the most photons a map may hold is read; one photon
+    /// more is refused, with that reason, before its records are read.
+    #[test]
+    fn a_map_of_the_most_photons_is_read_and_one_more_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("maps.photons");
+        save_photon_maps(&maps_of(5, 3), 1, 2, &path).unwrap();
+        let read = load_bounded(&path, 1, 2, 5).unwrap();
+        assert_eq!((read.global.len(), read.caustic.len()), (5, 3));
+        let refused = load_bounded(&path, 1, 2, 4).unwrap_err().to_string();
+        assert!(refused.contains("the global map claims 5 photons, more than the 4 a map may hold"), "{refused}");
     }
 }
