@@ -118,8 +118,7 @@ pub fn shear_of<R: Real>(origin: V3<R>, direction: V3<R>, vertices: [V3<R>; 3]) 
 /// against: its direction's largest axis and the shear.
 #[derive(Clone, Copy)]
 pub struct RayShear<R: Real> {
-    y_largest: R::Mask,
-    z_largest: R::Mask,
+    permutation: Permutation<R>,
     /// The origin, permuted.
     origin: V3<R>,
     sx: R,
@@ -127,30 +126,74 @@ pub struct RayShear<R: Real> {
     sz: R,
 }
 
-/// Permuted so that z is the largest axis: a selection, so permuting a
-/// difference is the difference of the permuted (bit for bit).
-/// Functions, not closures: a closure is left out of line, without AVX2.
-#[inline(always)]
-fn permute<R: Real>(v: V3<R>, y_largest: R::Mask, z_largest: R::Mask) -> V3<R> {
-    V3::new(
-        R::select(z_largest, v.x, R::select(y_largest, v.z, v.y)),
-        R::select(z_largest, v.y, R::select(y_largest, v.x, v.z)),
-        R::select(z_largest, v.z, R::select(y_largest, v.y, v.x)),
-    )
+/// Which axis becomes z.
+#[derive(Clone, Copy)]
+enum Permutation<R: Real> {
+    /// Lane by lane: rays of their own.
+    Lanes { y_largest: R::Mask, z_largest: R::Mask },
+    /// One ray's in every lane (0, 1, 2: x, y or z largest): a reordering,
+    /// not selects.
+    Uniform(usize),
+}
+
+impl<R: Real> Permutation<R> {
+    /// Permuting is a selection, so permuting a difference is the
+    /// difference of the permuted (bit for bit). Functions, not closures: a
+    /// closure is left out of line, without AVX2.
+    #[inline(always)]
+    fn apply(&self, v: V3<R>) -> V3<R> {
+        match *self {
+            Permutation::Lanes { y_largest, z_largest } => V3::new(
+                R::select(z_largest, v.x, R::select(y_largest, v.z, v.y)),
+                R::select(z_largest, v.y, R::select(y_largest, v.x, v.z)),
+                R::select(z_largest, v.z, R::select(y_largest, v.y, v.x)),
+            ),
+            Permutation::Uniform(2) => v,
+            Permutation::Uniform(1) => V3::new(v.z, v.x, v.y),
+            Permutation::Uniform(_) => V3::new(v.y, v.z, v.x),
+        }
+    }
 }
 
 #[inline(always)]
 pub fn ray_shear_of<R: Real>(origin: V3<R>, direction: V3<R>) -> RayShear<R> {
-    // glam's `max_position` of |d| (the first largest), as selects
+    let (y_largest, z_largest) = largest_axis_of(direction);
+    RayShear::with(Permutation::Lanes { y_largest, z_largest }, origin, direction)
+}
+
+/// glam's `max_position` of |d| (the first largest), as selects: whether y
+/// is larger than x, whether z is larger than both.
+#[inline(always)]
+fn largest_axis_of<R: Real>(direction: V3<R>) -> (R::Mask, R::Mask) {
     let a = direction.abs();
     let y_largest = a.y.gt(a.x);
-    let z_largest = a.z.gt(R::select(y_largest, a.y, a.x));
-    let d = permute(direction, y_largest, z_largest);
-    let sz = R::splat(1.0) / d.z;
-    RayShear { y_largest, z_largest, origin: permute(origin, y_largest, z_largest), sx: -d.x * sz, sy: -d.y * sz, sz }
+    (y_largest, a.z.gt(R::select(y_largest, a.y, a.x)))
 }
 
 impl<R: Real> RayShear<R> {
+    #[inline(always)]
+    fn with(permutation: Permutation<R>, origin: V3<R>, direction: V3<R>) -> Self {
+        let d = permutation.apply(direction);
+        let sz = R::splat(1.0) / d.z;
+        RayShear { permutation, origin: permutation.apply(origin), sx: -d.x * sz, sy: -d.y * sz, sz }
+    }
+
+    /// One ray's shear in every lane, to test it against several triangles
+    /// side by side: the same numbers as `ray_shear_of` of the ray splat.
+    #[inline(always)]
+    pub fn of_one_ray(origin: Vec3, direction: Vec3) -> Self {
+        let (y_largest, z_largest) = largest_axis_of::<f32>(direction.into());
+        let one = RayShear::<f32>::with(Permutation::Lanes { y_largest, z_largest }, origin.into(), direction.into());
+        let splat = |v: V3<f32>| V3::new(R::splat(v.x), R::splat(v.y), R::splat(v.z));
+        RayShear {
+            permutation: Permutation::Uniform(if z_largest { 2 } else { y_largest as usize }),
+            origin: splat(one.origin),
+            sx: R::splat(one.sx),
+            sy: R::splat(one.sy),
+            sz: R::splat(one.sz),
+        }
+    }
+
     /// A triangle's vertices in the ray's sheared space, and the scale of z.
     #[inline(always)]
     pub fn vertices(&self, [p0, p1, p2]: [V3<R>; 3]) -> ([V3<R>; 3], R) {
@@ -159,7 +202,7 @@ impl<R: Real> RayShear<R> {
 
     #[inline(always)]
     fn vertex(&self, p: V3<R>) -> V3<R> {
-        let p = permute(p, self.y_largest, self.z_largest) - self.origin;
+        let p = self.permutation.apply(p) - self.origin;
         V3::new(p.x + self.sx * p.z, p.y + self.sy * p.z, p.z)
     }
 }

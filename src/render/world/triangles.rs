@@ -10,7 +10,7 @@
 use glam::{BVec4A, Vec4};
 
 use crate::geometry::real::V3;
-use crate::geometry::{edges_of, may_reach_of, shear_of, triangle_hit_of, watertight_finish_of, watertight_range_of};
+use crate::geometry::{edges_of, may_reach_of, triangle_hit_of, watertight_finish_of, watertight_range_of, RayShear};
 use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
 
 /// Four triangles' vertices and bounding balls, lane by lane.
@@ -69,14 +69,14 @@ impl TriangleLanes {
     /// One group against `ray` within (0, t_max); `None` where its balls
     /// turn the ray away in every lane (most groups, for most rays).
     #[inline(always)]
-    fn verdict(group: &Group, ray: &Ray, t_max: f32) -> Option<Verdict> {
+    fn verdict(group: &Group, ray: &Ray, shear: &RayShear<Vec4>, t_max: f32) -> Option<Verdict> {
         let (origin, direction) = (V3::<Vec4>::splat(ray.origin), V3::<Vec4>::splat(ray.direction));
         let limit = Vec4::splat(t_max);
         let reach = may_reach_of(origin, direction, group.center, group.radius, limit).bitmask() & group.full;
         if reach == 0 {
             return None;
         }
-        let (sheared, sz) = shear_of(origin, direction, group.vertices);
+        let (sheared, sz) = shear.vertices(group.vertices);
         let edges = edges_of(sheared);
         let zero = Vec4::ZERO;
         let on_edge: BVec4A = edges[0].cmpeq(zero) | edges[1].cmpeq(zero) | edges[2].cmpeq(zero);
@@ -97,8 +97,9 @@ impl TriangleLanes {
     pub fn nearest(&self, triangles: &[(Triangle, u32)], ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
         let mut best_t = t_max;
         let mut found = None;
+        let shear = RayShear::of_one_ray(ray.origin, ray.direction);
         for (g, group) in self.groups.iter().enumerate() {
-            let Some(verdict) = Self::verdict(group, ray, best_t) else { continue };
+            let Some(verdict) = Self::verdict(group, ray, &shear, best_t) else { continue };
             let (mut lanes, mut narrowed) = (verdict.hit | verdict.scalar, false);
             while lanes != 0 {
                 let lane = lanes.trailing_zeros() as usize;
@@ -140,8 +141,9 @@ impl TriangleLanes {
     /// (0, t_max).
     #[inline]
     pub fn any_hit(&self, triangles: &[(Triangle, u32)], ray: &Ray, t_max: f32, skip: impl Fn(u32) -> bool) -> bool {
+        let shear = RayShear::of_one_ray(ray.origin, ray.direction);
         self.groups.iter().enumerate().any(|(g, group)| {
-            let Some(verdict) = Self::verdict(group, ray, t_max) else { return false };
+            let Some(verdict) = Self::verdict(group, ray, &shear, t_max) else { return false };
             let mut lanes = verdict.hit | verdict.scalar;
             while lanes != 0 {
                 let lane = lanes.trailing_zeros() as usize;
@@ -165,6 +167,7 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
+    use crate::geometry::shear_of;
     use crate::render::world::rng::Sampler;
     use crate::render::world::sampling::uniform_sphere;
 
