@@ -161,15 +161,12 @@ pub fn estimate(
     let mut sum = Rgb::ZERO;
     if found > 0 && radius2 > 0.0 {
         let photons = tree.photons();
+        // `k_nearest` kept only photons arriving at the front (wi·n > 0),
+        // where a constant BSDF is its constant
         let constant = bsdf.front_constant(wo, normal);
         for &(_, index) in neighbours.as_slice() {
             let photon = &photons[index as usize];
-            let wi = -photon.incoming_direction();
-            let f = match constant {
-                Some(f) if wi.dot(normal) > 0.0 => f,
-                Some(_) => Rgb::ZERO,
-                None => bsdf.eval(wo, wi, normal),
-            };
+            let f = constant.unwrap_or_else(|| bsdf.eval(wo, -photon.incoming_direction(), normal));
             sum += f * Vec3::from_array(photon.power);
         }
         sum /= PI * radius2;
