@@ -96,16 +96,29 @@ fn partition<P: KdPoint>(records: &mut [P]) {
     }
 }
 
-/// Copy the subtree in in-order `records` into `tree` at heap index `node`,
-/// reading the records in sequence.
-fn to_heap_order<P: KdPoint>(records: &[P], tree: &mut [P], node: usize) {
-    if records.is_empty() {
-        return;
+/// `records`, in the tree's in-order, into heap order: an in-order walk of
+/// the heap's indices meets the nodes in that order, so it takes the records
+/// in sequence (a stack of the left spine, no subtree sizes).
+fn to_heap_order<P: KdPoint>(records: &[P]) -> Vec<P> {
+    let n = records.len();
+    let mut tree = vec![P::default(); n];
+    // A node's depth is below 64 for any n that fits in memory
+    let mut stack = [0usize; 64];
+    let (mut top, mut node, mut next) = (0, 0, 0);
+    loop {
+        while node < n {
+            stack[top] = node;
+            top += 1;
+            node = 2 * node + 1;
+        }
+        if top == 0 {
+            return tree;
+        }
+        top -= 1;
+        tree[stack[top]] = records[next];
+        next += 1;
+        node = 2 * stack[top] + 2;
     }
-    let median = left_subtree_size(records.len());
-    to_heap_order(&records[..median], tree, 2 * node + 1);
-    tree[node] = records[median];
-    to_heap_order(&records[median + 1..], tree, 2 * node + 2);
 }
 
 impl<P: KdPoint> KdTree<P> {
@@ -119,10 +132,8 @@ impl<P: KdPoint> KdTree<P> {
     pub fn build(mut photons: Vec<P>) -> Self {
         let n = photons.len();
         partition(&mut photons);
-        let mut tree = vec![P::default(); n];
-        to_heap_order(&photons, &mut tree, 0);
         let depth = (usize::BITS - n.leading_zeros()) as usize;
-        Self { photons: tree, depth }
+        Self { photons: to_heap_order(&photons), depth }
     }
 
     /// A tree read back from a file, already in heap order; refused (with
