@@ -4,7 +4,6 @@
 
 mod frame;
 mod plane;
-mod pow;
 mod ray;
 pub mod real;
 pub mod sphere;
@@ -13,7 +12,6 @@ mod triangle;
 pub use frame::{frame_from_z, to_world, Frame};
 pub use plane::intersect_plane;
 pub(crate) use plane::{plane_exit_of, plane_exit_t, plane_hit, plane_point_of, plane_t, plane_t_of};
-pub use pow::pow_of;
 pub use ray::{gamma, offset_origin, offset_ray_origin, spawn_offset_scale, Ray};
 pub use sphere::intersect_sphere;
 pub(crate) use sphere::sphere_hit;

@@ -10,11 +10,6 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use glam::{BVec4A, Vec3, Vec4};
 
-/// 1.5·2²³: a float this size has unit spacing, so adding it rounds to a
-/// whole number (to even on a tie; for magnitudes below 2²²). No float-to-int
-/// conversion: `f32::round` is a libm call without SSE4.1.
-pub const ROUND_BY_ADDING: f32 = 12_582_912.0;
-
 /// Which lanes a comparison held in.
 pub trait Mask: Copy {
     fn and(self, other: Self) -> Self;
@@ -53,11 +48,8 @@ pub trait Real:
     /// Unordered: true where either is NaN.
     fn ne(self, other: Self) -> Self::Mask;
     fn is_finite(self) -> Self::Mask;
-    /// For positive normal floats: (m, e) with `self` = m·2^e, m in [1, 2).
-    /// Elsewhere what the bits give (the callers select those lanes away).
-    fn split_exponent(self) -> (Self, Self);
-    /// 2^`self` for whole numbers in [−126, 127].
-    fn exp2_whole(self) -> Self;
+    /// `f32::powf` (libm's), lane by lane.
+    fn powf(self, exponent: Self) -> Self;
     /// `a` where `mask` holds, `b` elsewhere.
     fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
     /// The spacing of floats in `self`'s binade, 23 bits below its exponent
@@ -149,13 +141,8 @@ impl Real for f32 {
         f32::is_finite(self)
     }
     #[inline(always)]
-    fn split_exponent(self) -> (f32, f32) {
-        let bits = self.to_bits();
-        (f32::from_bits(bits & 0x007f_ffff | 0x3f80_0000), ((bits >> 23) as i32 - 127) as f32)
-    }
-    #[inline(always)]
-    fn exp2_whole(self) -> f32 {
-        f32::from_bits(((self as i32 + 127) as u32) << 23)
+    fn powf(self, exponent: f32) -> f32 {
+        f32::powf(self, exponent)
     }
     #[inline(always)]
     fn select(mask: bool, a: f32, b: f32) -> f32 {
@@ -251,13 +238,8 @@ impl Real for Vec4 {
         self.is_finite_mask()
     }
     #[inline(always)]
-    fn split_exponent(self) -> (Self, Self) {
-        let [a, b, c, d] = self.to_array().map(Real::split_exponent);
-        (Vec4::new(a.0, b.0, c.0, d.0), Vec4::new(a.1, b.1, c.1, d.1))
-    }
-    #[inline(always)]
-    fn exp2_whole(self) -> Self {
-        Vec4::from_array(self.to_array().map(Real::exp2_whole))
+    fn powf(self, exponent: Self) -> Self {
+        Vec4::new(self.x.powf(exponent.x), self.y.powf(exponent.y), self.z.powf(exponent.z), self.w.powf(exponent.w))
     }
     #[inline(always)]
     fn select(mask: BVec4A, a: Self, b: Self) -> Self {

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use crate::faults::{self, Fault};
 use crate::geometry::real::{Real, V3};
-use crate::geometry::{pow_of, Frame};
+use crate::geometry::Frame;
 use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::{
     cosine_hemisphere, cosine_hemisphere_pdf, cosine_hemisphere_pdf_of, power_cosine,
@@ -145,7 +145,7 @@ fn glossy_of<R: Real>(
     cos_wi: R,
 ) -> (V3<R>, R) {
     let zero = R::splat(0.0);
-    let power = pow_of(cos.max(zero), exponent);
+    let power = cos.max(zero).powf(exponent);
     let lobe = ks * (lobe_scale * power);
     let specular = R::select(cos.le(zero), zero, (exponent + 1.0) * 0.5 * FRAC_1_PI * power) / pdf_divisor;
     (kd * R::splat(FRAC_1_PI) + lobe, pd * cosine_hemisphere_pdf_of(cos_wi) + (R::splat(1.0) - pd) * specular)

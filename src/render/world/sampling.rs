@@ -4,8 +4,10 @@ use std::f32::consts::{FRAC_1_PI, FRAC_2_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::pow_of;
-use crate::geometry::real::{Mask, Real, ROUND_BY_ADDING, V3};
+use crate::geometry::real::{Mask, Real, V3};
+
+/// 1.5·2²³: a float this size has unit spacing, so adding it rounds to an integer.
+pub(crate) const ROUND_BY_ADDING: f32 = 12_582_912.0;
 
 /// sin x and cos x together, inline: the warps below call them once per
 /// sample, and libm's out-of-line `sincosf` was 5% of path tracing. Reduced
@@ -157,7 +159,7 @@ pub fn power_cosine(u: Vec2, exponent: f32) -> Vec3 {
 /// `power_cosine` for one sample or several.
 #[inline(always)]
 pub fn power_cosine_of<R: Real>(u0: R, u1: R, exponent: R) -> V3<R> {
-    let cos_theta = pow_of(u0, R::splat(1.0) / (exponent + 1.0));
+    let cos_theta = u0.powf(R::splat(1.0) / (exponent + 1.0));
     let sin_theta = (R::splat(1.0) - cos_theta * cos_theta).max(R::splat(0.0)).sqrt();
     let (sin, cos) = sin_cos_of(u1 * (2.0 * PI));
     V3::new(sin_theta * cos, sin_theta * sin, cos_theta)
@@ -171,7 +173,7 @@ pub fn power_cosine_pdf(cos_theta: f32, exponent: f32) -> f32 {
 /// `power_cosine_pdf` for one direction or several.
 #[inline(always)]
 pub fn power_cosine_pdf_of<R: Real>(cos_theta: R, exponent: R) -> R {
-    let pdf = (exponent + 1.0) * 0.5 * FRAC_1_PI * pow_of(cos_theta, exponent);
+    let pdf = (exponent + 1.0) * 0.5 * FRAC_1_PI * cos_theta.powf(exponent);
     R::select(cos_theta.le(R::splat(0.0)), R::splat(0.0), pdf)
 }
 

@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use super::photon_map::emit::LightPicker;
 use super::photon_map::kdtree::KdTree;
 use super::{Counters, PassObserver, PassReport, Stage};
-use crate::geometry::{pow_of, Ray};
+use crate::geometry::Ray;
 use crate::render::film::{Film, TermSums};
 use crate::render::settings::{Algorithm, Method, MisHeuristic, RenderSettings};
 use crate::render::world::camera::{CameraModel, CameraTile};
@@ -144,7 +144,7 @@ impl Bidir {
 
     /// The merge radius of pass `pass` (from 0): r₀ / (pass + 1)^((1−α)/2).
     pub fn merge_radius(&self, pass: u32) -> f32 {
-        (self.radius / pow_of((pass + 1) as f32, 0.5 * (1.0 - self.alpha))).max(1e-7)
+        (self.radius / ((pass + 1) as f32).powf(0.5 * (1.0 - self.alpha))).max(1e-7)
     }
 
     /// The strategies of pass `pass` over `pixels` pixels, and how they weigh.

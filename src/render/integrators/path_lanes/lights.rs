@@ -4,8 +4,9 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::geometry::real::Real;
 use crate::geometry::sphere::nearest_root;
-use crate::geometry::{frame_from_z, offset_origin, pow_of, ray_to, to_world, SurfaceHit};
+use crate::geometry::{frame_from_z, offset_origin, ray_to, to_world, SurfaceHit};
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
 use crate::render::world::light::{solid_angle_pdf_of, triangle_point_of, Emitter, LightSource};
 use crate::render::world::sampling::{uniform_cone_of, uniform_cone_pdf_of, uniform_triangle_of};
@@ -417,7 +418,7 @@ impl LightLanes {
             // the light gives no sample
             let cos = points.v8(|light| light.axis).dot(-wi);
             let exponent = points.f8(|light| light.exponent);
-            let inside = exponent.eq(F8::splat(0.0)).select(F8::splat(1.0), pow_of(cos, exponent));
+            let inside = exponent.eq(F8::splat(0.0)).select(F8::splat(1.0), cos.powf(exponent));
             let spot = cos.lt(points.f8(|light| light.cos_cone)).select(F8::splat(0.0), inside);
             let value = points.v8(|light| light.intensity) * (attenuation * spot);
             let valid = lanes.and_not(spot.eq(F8::splat(0.0)));

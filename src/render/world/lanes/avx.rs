@@ -138,28 +138,6 @@ impl F8 {
         })
     }
 
-    /// `Real::split_exponent`: the mantissa with a zero exponent, and the
-    /// exponent's bits less the bias.
-    #[inline(always)]
-    pub fn split_exponent(self) -> (Self, Self) {
-        unsafe {
-            let bits = _mm256_castps_si256(self.0);
-            let mantissa =
-                _mm256_or_si256(_mm256_and_si256(bits, _mm256_set1_epi32(0x007f_ffff)), _mm256_set1_epi32(0x3f80_0000));
-            let exponent = _mm256_sub_epi32(_mm256_srli_epi32::<23>(bits), _mm256_set1_epi32(127));
-            (F8(_mm256_castsi256_ps(mantissa)), F8(_mm256_cvtepi32_ps(exponent)))
-        }
-    }
-
-    /// `Real::exp2_whole`: the biased exponent shifted into place.
-    #[inline(always)]
-    pub fn exp2_whole(self) -> Self {
-        F8(unsafe {
-            let biased = _mm256_add_epi32(_mm256_cvttps_epi32(self.0), _mm256_set1_epi32(127));
-            _mm256_castsi256_ps(_mm256_slli_epi32::<23>(biased))
-        })
-    }
-
     /// `as i32` for lanes within i32's range (whole numbers: indices).
     #[inline(always)]
     pub fn truncate(self) -> [i32; LANES] {

@@ -4,7 +4,6 @@
 
 use std::ops::{Add, Div, Mul, Neg, Not, Sub};
 
-use crate::geometry::real::Real;
 use crate::render::world::lanes::{each as from_fn, LANES};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -117,16 +116,6 @@ impl F8 {
     #[inline(always)]
     pub fn binade_ulp(self) -> Self {
         self.map(|v| f32::from_bits((v.to_bits() & 0x7f80_0000).saturating_sub(23 << 23)))
-    }
-
-    #[inline(always)]
-    pub fn split_exponent(self) -> (Self, Self) {
-        (F8(from_fn(|i| self.0[i].split_exponent().0)), F8(from_fn(|i| self.0[i].split_exponent().1)))
-    }
-
-    #[inline(always)]
-    pub fn exp2_whole(self) -> Self {
-        self.map(Real::exp2_whole)
     }
 
     /// `as i32` for lanes within i32's range (whole numbers: indices).
