@@ -388,4 +388,18 @@ mod tests {
         let refused = load_bounded(&path, 1, 2, 4).unwrap_err().to_string();
         assert!(refused.contains("the global map claims 5 photons, more than the 4 a map may hold"), "{refused}");
     }
+
+    /// A gather radius of 0 (or below) is refused even in a file whose
+    /// checksum holds: every estimate would divide by it.
+    #[test]
+    fn a_file_with_no_gather_radius_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        for radius in [0.0, -0.5] {
+            let path = dir.path().join(format!("maps-{radius}.photons"));
+            let maps = PhotonMaps { max_radius: radius, ..maps_of(2, 1) };
+            save_photon_maps(&maps, 1, 2, &path).unwrap();
+            let refused = load_photon_maps(&path, 1, 2).unwrap_err().to_string();
+            assert!(refused.contains(&format!("its gather radius is {radius}")), "{refused}");
+        }
+    }
 }
