@@ -159,7 +159,9 @@ pub fn estimate(
     let bin = ((radius2.sqrt() / max_radius) * RADIUS_BINS as f32) as usize;
     stats.radius_histogram[bin.min(RADIUS_BINS - 1)] += 1;
     let mut sum = Rgb::ZERO;
-    if found > 0 && radius2 > 0.0 {
+    // With nothing found the sum is 0; a radius of 0 (k photons on the
+    // point itself) has no density to give
+    if radius2 > 0.0 {
         let photons = tree.photons();
         // `k_nearest` kept only photons arriving at the front (wi·n > 0),
         // where a constant BSDF is its constant
