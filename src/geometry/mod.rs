@@ -4,6 +4,7 @@
 
 mod frame;
 mod plane;
+pub mod pow;
 mod ray;
 pub mod real;
 pub mod sphere;

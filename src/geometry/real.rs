@@ -10,6 +10,8 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use glam::{BVec4A, Vec3, Vec4};
 
+use super::pow;
+
 /// Which lanes a comparison held in.
 pub trait Mask: Copy {
     fn and(self, other: Self) -> Self;
@@ -48,7 +50,7 @@ pub trait Real:
     /// Unordered: true where either is NaN.
     fn ne(self, other: Self) -> Self::Mask;
     fn is_finite(self) -> Self::Mask;
-    /// `f32::powf` (libm's), lane by lane.
+    /// `pow::powf`, lane by lane.
     fn powf(self, exponent: Self) -> Self;
     /// `a` where `mask` holds, `b` elsewhere.
     fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
@@ -142,7 +144,7 @@ impl Real for f32 {
     }
     #[inline(always)]
     fn powf(self, exponent: f32) -> f32 {
-        f32::powf(self, exponent)
+        pow::powf(self, exponent)
     }
     #[inline(always)]
     fn select(mask: bool, a: f32, b: f32) -> f32 {
@@ -239,7 +241,12 @@ impl Real for Vec4 {
     }
     #[inline(always)]
     fn powf(self, exponent: Self) -> Self {
-        Vec4::new(self.x.powf(exponent.x), self.y.powf(exponent.y), self.z.powf(exponent.z), self.w.powf(exponent.w))
+        Vec4::new(
+            pow::powf(self.x, exponent.x),
+            pow::powf(self.y, exponent.y),
+            pow::powf(self.z, exponent.z),
+            pow::powf(self.w, exponent.w),
+        )
     }
     #[inline(always)]
     fn select(mask: BVec4A, a: Self, b: Self) -> Self {

@@ -12,7 +12,7 @@ use glam::Vec3;
 
 use super::next_event::PathScope;
 use super::Stage;
-use crate::geometry::Ray;
+use crate::geometry::{pow, Ray};
 use crate::render::integrators::Counters;
 use crate::render::world::bsdf::{reflect, refract};
 use crate::render::world::camera::CameraTile;
@@ -152,7 +152,7 @@ fn local(
         let mut c = kd * cos;
         if ks != Rgb::ZERO {
             let highlight = if blinn { n.dot((sample.wi + wo).normalize()) } else { reflect(sample.wi, n).dot(wo) };
-            c += ks * highlight.max(0.0).powf(exponent);
+            c += ks * pow::powf(highlight.max(0.0), exponent);
         }
         total += light_colour * c;
     }

@@ -13,7 +13,7 @@ use glam::{Vec2, Vec3};
 use super::light::{spot_factor, Emitter, LightSource};
 use super::sampling::{concentric_disk, cosine_hemisphere, uniform_cone, uniform_cone_pdf, uniform_sphere};
 use super::sampling::{uniform_sphere_pdf, uniform_triangle};
-use crate::geometry::{offset_ray_origin, Frame, Ray, SurfaceHit};
+use crate::geometry::{offset_ray_origin, pow, Frame, Ray, SurfaceHit};
 use crate::scene::Rgb;
 
 /// The region infinite lights must light: a sphere about what the camera
@@ -80,7 +80,7 @@ impl LightSource {
             LightSource::Point { intensity, .. } => intensity * (4.0 * PI),
             LightSource::Spot { intensity, cos_cone, exponent, .. } => {
                 // ∫ over the cone of cos^σ θ dω = 2π (1 − cos^{σ+1} θc)/(σ + 1)
-                intensity * (2.0 * PI * (1.0 - cos_cone.powf(exponent + 1.0)) / (exponent + 1.0))
+                intensity * (2.0 * PI * (1.0 - pow::powf(cos_cone, exponent + 1.0)) / (exponent + 1.0))
             }
             LightSource::Directional { irradiance, .. } => irradiance * bounds.disc_area(),
             LightSource::Area { radiance, ref emitter, .. } => radiance * (PI * emitter.area()),

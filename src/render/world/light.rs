@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 use super::sampling::{uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_sphere_pdf, uniform_triangle};
 use crate::faults::{self, Fault};
 use crate::geometry::real::{Real, V3};
-use crate::geometry::{Frame, Ray, SurfaceHit, Triangle};
+use crate::geometry::{pow, Frame, Ray, SurfaceHit, Triangle};
 use crate::scene::{Attenuation, Rgb};
 
 /// The part of a sphere that can light the scene: a cap about `frame.z`
@@ -194,10 +194,8 @@ pub fn spot_factor(axis: Vec3, light_to_point: Vec3, cos_cone: f32, exponent: f3
     let cos = axis.dot(light_to_point);
     if cos < cos_cone {
         0.0
-    } else if exponent == 0.0 {
-        1.0
     } else {
-        cos.powf(exponent)
+        pow::powf(cos, exponent)
     }
 }
 

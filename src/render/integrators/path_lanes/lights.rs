@@ -4,7 +4,6 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::real::Real;
 use crate::geometry::sphere::nearest_root;
 use crate::geometry::{frame_from_z, offset_origin, ray_to, to_world, SurfaceHit};
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
@@ -418,8 +417,7 @@ impl LightLanes {
             // the light gives no sample
             let cos = points.v8(|light| light.axis).dot(-wi);
             let exponent = points.f8(|light| light.exponent);
-            let inside = exponent.eq(F8::splat(0.0)).select(F8::splat(1.0), cos.powf(exponent));
-            let spot = cos.lt(points.f8(|light| light.cos_cone)).select(F8::splat(0.0), inside);
+            let spot = cos.lt(points.f8(|light| light.cos_cone)).select(F8::splat(0.0), cos.powf(exponent));
             let value = points.v8(|light| light.intensity) * (attenuation * spot);
             let valid = lanes.and_not(spot.eq(F8::splat(0.0)));
             out.set(lanes, valid, wi, value, origin, t_max);

@@ -14,6 +14,7 @@ use std::arch::x86_64::*;
 use std::fmt;
 use std::ops::{Add, Div, Mul, Neg, Not, Sub};
 
+use crate::geometry::pow;
 use crate::render::world::lanes::LANES;
 
 #[derive(Clone, Copy)]
@@ -146,6 +147,63 @@ impl F8 {
         out
     }
 
+    /// `pow::powf` lane by lane, four lanes at a time in f64 with its
+    /// operations in its order, unfused, so the bits are the scalar
+    /// function's. Lanes off its fast path take it one by one, but x⁰ = 1
+    /// and 0ʸ = 0 (y > 0), which glossy paths meet all the time (Lambert
+    /// lanes, directions outside the lobe), are answered here.
+    #[inline(always)]
+    pub fn powf(self, exponent: F8) -> F8 {
+        unsafe {
+            let x_bits = _mm256_castps_si256(self.0);
+            let y_abs_bits = _mm256_castps_si256(exponent.abs().0);
+            // `pow::takes_fast_path`: x positive, normal and finite; y finite, not 0
+            let x_normal = _mm256_and_si256(
+                _mm256_cmpgt_epi32(x_bits, _mm256_set1_epi32(0x007f_ffff)),
+                _mm256_cmpgt_epi32(_mm256_set1_epi32(0x7f80_0000), x_bits),
+            );
+            let y_zero = _mm256_cmpeq_epi32(y_abs_bits, _mm256_setzero_si256());
+            let y_finite = _mm256_cmpgt_epi32(_mm256_set1_epi32(0x7f80_0000), y_abs_bits);
+            let fast = M8(_mm256_castsi256_ps(_mm256_andnot_si256(y_zero, _mm256_and_si256(x_normal, y_finite))));
+            // log₂ x's table index, exponent and reduced mantissa (`pow::log2_of`)
+            let from_offset = _mm256_sub_epi32(x_bits, _mm256_set1_epi32(pow::LOG2_OFFSET as i32));
+            let entry =
+                _mm256_slli_epi32::<1>(_mm256_and_si256(_mm256_srli_epi32::<19>(from_offset), _mm256_set1_epi32(15)));
+            let top = _mm256_and_si256(from_offset, _mm256_set1_epi32(0xff80_0000u32 as i32));
+            let z = _mm256_castsi256_ps(_mm256_sub_epi32(x_bits, top));
+            let k = _mm256_srai_epi32::<23>(top);
+            let low = power_half(
+                _mm256_castps256_ps128(z),
+                _mm256_castsi256_si128(k),
+                _mm256_castsi256_si128(entry),
+                _mm256_castps256_ps128(exponent.0),
+            );
+            let high = power_half(
+                _mm256_extractf128_ps::<1>(z),
+                _mm256_extracti128_si256::<1>(k),
+                _mm256_extracti128_si256::<1>(entry),
+                _mm256_extractf128_ps::<1>(exponent.0),
+            );
+            let power = F8(_mm256_set_m128(high, low));
+            let zero_base = M8(_mm256_castsi256_ps(_mm256_cmpeq_epi32(x_bits, _mm256_setzero_si256())))
+                .and(exponent.gt(F8::splat(0.0)));
+            // A signalling NaN's x⁰ is NaN in libm
+            let one = M8(_mm256_castsi256_ps(y_zero)).and(self.eq(self));
+            let answered = fast.or(one).or(zero_base);
+            let power = fast.select(power, one.select(F8::splat(1.0), F8::splat(0.0)));
+            if answered.bits() == (1 << LANES) - 1 {
+                return power;
+            }
+            let (x, y, mut out) = (self.to_array(), exponent.to_array(), power.to_array());
+            for i in 0..LANES {
+                if answered.bits() >> i & 1 == 0 {
+                    out[i] = pow::powf(x[i], y[i]);
+                }
+            }
+            F8::from_array(out)
+        }
+    }
+
     /// Lanes whose bit pattern has any of `bits` set.
     #[inline(always)]
     pub fn bits_set(self, bits: u32) -> M8 {
@@ -155,6 +213,44 @@ impl F8 {
             _mm256_castsi256_ps(_mm256_xor_si256(clear, _mm256_set1_epi32(-1)))
         })
     }
+}
+
+/// Four lanes of `F8::powf`'s fast path from the parts of x and y: the
+/// reduced mantissa `z`, exponent `k` and table `entry` of x, and y.
+/// A function, not a closure: a closure is left out of line, without AVX2.
+#[inline(always)]
+unsafe fn power_half(z: __m128, k: __m128i, entry: __m128i, y: __m128) -> __m128 {
+    let table = pow::LOG2_TABLE.as_ptr().cast::<f64>();
+    let inv_c = _mm256_i32gather_pd::<8>(table, entry);
+    let log2_c = _mm256_i32gather_pd::<8>(table, _mm_add_epi32(entry, _mm_set1_epi32(1)));
+    let r = _mm256_sub_pd(_mm256_mul_pd(_mm256_cvtps_pd(z), inv_c), _mm256_set1_pd(1.0));
+    let y0 = _mm256_add_pd(log2_c, _mm256_cvtepi32_pd(k));
+    let [a0, a1, a2, a3, a4] = pow::LOG2_POLY;
+    let r2 = _mm256_mul_pd(r, r);
+    let p1 = _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(a0), r), _mm256_set1_pd(a1));
+    let p2 = _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(a2), r), _mm256_set1_pd(a3));
+    let r4 = _mm256_mul_pd(r2, r2);
+    let q = _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(a4), r), y0);
+    let q = _mm256_add_pd(_mm256_mul_pd(p2, r2), q);
+    let log2_x = _mm256_add_pd(_mm256_mul_pd(p1, r4), q);
+    let y_log2_x = _mm256_mul_pd(_mm256_cvtps_pd(y), log2_x);
+    // 2^(y log₂ x) (`pow::exp2_of`), then f32's bounds
+    let shift = _mm256_set1_pd(pow::EXP2_SHIFT);
+    let shifted = _mm256_add_pd(y_log2_x, shift);
+    let k_bits = _mm256_castpd_si256(shifted);
+    let r = _mm256_sub_pd(y_log2_x, _mm256_sub_pd(shifted, shift));
+    let index = _mm256_and_si256(k_bits, _mm256_set1_epi64x(31));
+    let entry = _mm256_i64gather_epi64::<8>(pow::EXP2_TABLE.as_ptr().cast::<i64>(), index);
+    let scale = _mm256_castsi256_pd(_mm256_add_epi64(entry, _mm256_slli_epi64::<47>(k_bits)));
+    let [c0, c1, c2] = pow::EXP2_POLY;
+    let p = _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(c0), r), _mm256_set1_pd(c1));
+    let r2 = _mm256_mul_pd(r, r);
+    let q = _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(c2), r), _mm256_set1_pd(1.0));
+    let power = _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(p, r2), q), scale);
+    let over = _mm256_cmp_pd::<_CMP_GT_OQ>(y_log2_x, _mm256_set1_pd(pow::OVERFLOW));
+    let under = _mm256_cmp_pd::<_CMP_LE_OQ>(y_log2_x, _mm256_set1_pd(pow::UNDERFLOW));
+    let power = _mm256_blendv_pd(power, _mm256_set1_pd(f64::INFINITY), over);
+    _mm256_cvtpd_ps(_mm256_blendv_pd(power, _mm256_setzero_pd(), under))
 }
 
 macro_rules! lane_op {

@@ -4,6 +4,7 @@
 
 use std::ops::{Add, Div, Mul, Neg, Not, Sub};
 
+use crate::geometry::pow;
 use crate::render::world::lanes::{each as from_fn, LANES};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -122,6 +123,11 @@ impl F8 {
     #[inline(always)]
     pub fn truncate(self) -> [i32; LANES] {
         self.0.map(|v| v as i32)
+    }
+
+    #[inline(always)]
+    pub fn powf(self, exponent: F8) -> Self {
+        self.zip(exponent, pow::powf)
     }
 
     /// Lanes whose bit pattern has any of `bits` set.
