@@ -107,6 +107,7 @@ fn degenerate_sets() {
     // A radius of 0 holds the photons exactly there (distance ≤ radius)
     tree.for_each_within(Vec3::splat(0.5), 0.0, |_| found += 1);
     assert_eq!(found, 1000);
+    assert_eq!(tree_result(&tree, Vec3::splat(0.5), None, 50, 0.0), vec![0.0; 50]);
     // Photons from behind the surface are skipped: all travel down (-y), so a
     // surface facing down sees none of them
     assert!(tree_result(&tree, Vec3::splat(0.5), Some(-Vec3::Y), 50, 1.0).is_empty());
