@@ -19,7 +19,7 @@ pub(crate) use sphere::sphere_hit;
 pub use sphere::sphere_t;
 #[cfg(test)]
 pub(crate) use triangle::shear_of;
-pub(crate) use triangle::{edges_of, may_reach_of, ray_shear_of, triangle_hit_of, watertight_hit_of, RayShear};
+pub(crate) use triangle::{edges_of, may_reach_of, ray_shear_of, triangle_hit_of, RayShear};
 pub use triangle::{intersect_triangle, Triangle};
 pub(crate) use triangle::{watertight_finish_of, watertight_range_of};
 

@@ -26,7 +26,7 @@ use samples::{CameraSample, CameraSamples};
 use super::Counters;
 use crate::faults::{self, Fault};
 use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
-use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_hit_of, RayShear};
+use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_finish_of, watertight_range_of, RayShear};
 use crate::geometry::{frame_from_z, gamma, intersect_triangle, offset_origin, to_world, Ray, SurfaceHit, Triangle};
 use crate::geometry::{may_reach_of, plane_exit_of, plane_point_of, plane_t_of};
 use crate::render::world::bsdf::{blinn_normalisation, reflect_of, refraction_of, Bsdf, Refraction};
@@ -642,7 +642,11 @@ impl PathLanes {
         let edges = edges_of(sheared);
         let zero = F8::splat(0.0);
         let on_edge = near.and(edges[0].eq(zero).or(edges[1].eq(zero)).or(edges[2].eq(zero)));
-        let (mut t, hit, barycentrics) = watertight_hit_of(sheared, edges, sz, t_max);
+        let range = watertight_range_of(sheared, edges, sz, t_max);
+        if !near.and_not(range.missed).or(on_edge).any() {
+            return (M8::NONE, zero, V8::splat(Vec3::ZERO), zero);
+        }
+        let (mut t, hit, barycentrics) = watertight_finish_of(sheared, edges, range);
         let mut hits = near.and_not(on_edge).and(hit);
         let (mut point, mut error) = match hits.any() {
             true => triangle_hit_of(vertices, barycentrics),
