@@ -25,7 +25,12 @@ fn brute_force(photons: &[Photon], q: Vec3, normal: Option<Vec3>, k: usize, max_
 
 fn tree_result(tree: &PhotonKdTree, q: Vec3, normal: Option<Vec3>, k: usize, max_radius: f32) -> Vec<f32> {
     let mut out = Neighbours::new(k);
-    tree.k_nearest(q, normal, k, max_radius, &mut out);
+    let visited = tree.k_nearest(q, normal, k, max_radius, &mut out);
+    // The walk (the nodes-visited statistic) starts at the root and meets
+    // every neighbour it keeps
+    assert_eq!(visited > 0, k > 0 && !tree.is_empty() && max_radius >= 0.0);
+    assert!(visited >= out.len());
+    assert_eq!(out.is_empty(), out.len() == 0);
     let photons = tree.photons();
     let mut d: Vec<f32> = out
         .as_slice()
