@@ -260,6 +260,48 @@ mod tests {
         out
     }
 
+    /// relMSE against a stored reference is the definition written out in
+    /// f64, pixel by pixel and channel by channel: ((t − r)² − Var r) /
+    /// (r² + ε), averaged; without a variance it is `rel_mse`'s figure.
+    #[test]
+    fn rel_mse_against_a_reference_is_its_definition() {
+        use crate::analysis::reference::ReferenceInfo;
+        let r = gradient();
+        let t = noisy(&r, 0.3, 3);
+        let variance = noisy(&image(32, 24, |_, _| [0.0; 3]), 0.02, 4);
+        let info = ReferenceInfo {
+            scene: "gradient".into(),
+            key: String::new(),
+            algorithm: "path".into(),
+            width: 32,
+            height: 24,
+            samples_per_pixel: 1,
+            seconds: 0.0,
+            seed: 0,
+            program_version: String::new(),
+        };
+        let plain = Reference { image: r.clone(), variance: None, info: info.clone() };
+        let with_noise = Reference { image: r.clone(), variance: Some(variance.clone()), info };
+        let definition = |variance: Option<&LinearImage>| {
+            let mut sum = 0.0;
+            for (i, (tp, rp)) in t.pixels.iter().zip(&r.pixels).enumerate() {
+                for c in 0..3 {
+                    let (tv, rv) = (tp[c] as f64, rp[c] as f64);
+                    let var = variance.map_or(0.0, |v| v.pixels[i][c] as f64);
+                    sum += ((tv - rv) * (tv - rv) - var) / (rv * rv + REL_MSE_EPSILON);
+                }
+            }
+            sum / (3 * t.pixels.len()) as f64
+        };
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+        let got = rel_mse_against(&t, &plain).unwrap().rel_mse;
+        assert!(close(got, definition(None)), "{got} against {}", definition(None));
+        assert!(close(got, rel_mse(&t, &r, RelMseOptions::default()).unwrap()));
+        let got = rel_mse_against(&t, &with_noise).unwrap().rel_mse;
+        assert!(close(got, definition(Some(&variance))), "{got} against {}", definition(Some(&variance)));
+        assert!(definition(Some(&variance)) < definition(None));
+    }
+
     #[test]
     fn rmse_of_identical_is_zero_and_of_an_offset_is_the_offset() {
         let a = gradient();
