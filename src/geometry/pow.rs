@@ -7,24 +7,25 @@
 //! a fused version on CPUs with FMA), and its result in the last bit with it.
 //! Within 0.82 ulp of xʸ (Arm's bound); tested against f64 below.
 
-/// `(1/c, log₂ c)` for the 16 subintervals of the mantissa's range.
-pub(crate) const LOG2_TABLE: [(f64, f64); 16] = [
-    (f64::from_bits(0x3ff661ec79f8f3be), f64::from_bits(0xbfdefec65b963019)),
-    (f64::from_bits(0x3ff571ed4aaf883d), f64::from_bits(0xbfdb0b6832d4fca4)),
-    (f64::from_bits(0x3ff49539f0f010b0), f64::from_bits(0xbfd7418b0a1fb77b)),
-    (f64::from_bits(0x3ff3c995b0b80385), f64::from_bits(0xbfd39de91a6dcf7b)),
-    (f64::from_bits(0x3ff30d190c8864a5), f64::from_bits(0xbfd01d9bf3f2b631)),
-    (f64::from_bits(0x3ff25e227b0b8ea0), f64::from_bits(0xbfc97c1d1b3b7af0)),
-    (f64::from_bits(0x3ff1bb4a4a1a343f), f64::from_bits(0xbfc2f9e393af3c9f)),
-    (f64::from_bits(0x3ff12358f08ae5ba), f64::from_bits(0xbfb960cbbf788d5c)),
-    (f64::from_bits(0x3ff0953f419900a7), f64::from_bits(0xbfaa6f9db6475fce)),
-    (1.0, 0.0),
-    (f64::from_bits(0x3fee608cfd9a47ac), f64::from_bits(0x3fb338ca9f24f53d)),
-    (f64::from_bits(0x3feca4b31f026aa0), f64::from_bits(0x3fc476a9543891ba)),
-    (f64::from_bits(0x3feb2036576afce6), f64::from_bits(0x3fce840b4ac4e4d2)),
-    (f64::from_bits(0x3fe9c2d163a1aa2d), f64::from_bits(0x3fd40645f0c6651c)),
-    (f64::from_bits(0x3fe886e6037841ed), f64::from_bits(0x3fd88e9c2c1b9ff8)),
-    (f64::from_bits(0x3fe767dcf5534862), f64::from_bits(0x3fdce0a44eb17bcc)),
+/// `[1/c, log₂ c]` for the 16 subintervals of the mantissa's range (an
+/// array, not a tuple: the lanes gather from it by offset).
+pub(crate) const LOG2_TABLE: [[f64; 2]; 16] = [
+    [f64::from_bits(0x3ff661ec79f8f3be), f64::from_bits(0xbfdefec65b963019)],
+    [f64::from_bits(0x3ff571ed4aaf883d), f64::from_bits(0xbfdb0b6832d4fca4)],
+    [f64::from_bits(0x3ff49539f0f010b0), f64::from_bits(0xbfd7418b0a1fb77b)],
+    [f64::from_bits(0x3ff3c995b0b80385), f64::from_bits(0xbfd39de91a6dcf7b)],
+    [f64::from_bits(0x3ff30d190c8864a5), f64::from_bits(0xbfd01d9bf3f2b631)],
+    [f64::from_bits(0x3ff25e227b0b8ea0), f64::from_bits(0xbfc97c1d1b3b7af0)],
+    [f64::from_bits(0x3ff1bb4a4a1a343f), f64::from_bits(0xbfc2f9e393af3c9f)],
+    [f64::from_bits(0x3ff12358f08ae5ba), f64::from_bits(0xbfb960cbbf788d5c)],
+    [f64::from_bits(0x3ff0953f419900a7), f64::from_bits(0xbfaa6f9db6475fce)],
+    [1.0, 0.0],
+    [f64::from_bits(0x3fee608cfd9a47ac), f64::from_bits(0x3fb338ca9f24f53d)],
+    [f64::from_bits(0x3feca4b31f026aa0), f64::from_bits(0x3fc476a9543891ba)],
+    [f64::from_bits(0x3feb2036576afce6), f64::from_bits(0x3fce840b4ac4e4d2)],
+    [f64::from_bits(0x3fe9c2d163a1aa2d), f64::from_bits(0x3fd40645f0c6651c)],
+    [f64::from_bits(0x3fe886e6037841ed), f64::from_bits(0x3fd88e9c2c1b9ff8)],
+    [f64::from_bits(0x3fe767dcf5534862), f64::from_bits(0x3fdce0a44eb17bcc)],
 ];
 
 /// log₂(1 + r) ≈ A₄r + A₃r² + A₂r³ + A₁r⁴ + A₀r⁵ for |r| < 1/32.
@@ -125,7 +126,7 @@ fn log2_of(x_bits: u32) -> f64 {
     let top = from_offset & 0xff80_0000;
     let z = f32::from_bits(x_bits.wrapping_sub(top)) as f64;
     let k = (top as i32 >> 23) as f64;
-    let (inv_c, log2_c) = LOG2_TABLE[index];
+    let [inv_c, log2_c] = LOG2_TABLE[index];
     let r = z * inv_c - 1.0;
     let y0 = log2_c + k;
     let a = LOG2_POLY;

@@ -218,6 +218,8 @@ impl F8 {
 /// Four lanes of `F8::powf`'s fast path from the parts of x and y: the
 /// reduced mantissa `z`, exponent `k` and table `entry` of x, and y.
 /// A function, not a closure: a closure is left out of line, without AVX2.
+/// SAFETY: the gathers read within the tables, `entry` being 2·(0…15) and
+/// the exp2 index masked to 0…31.
 #[inline(always)]
 unsafe fn power_half(z: __m128, k: __m128i, entry: __m128i, y: __m128) -> __m128 {
     let table = pow::LOG2_TABLE.as_ptr().cast::<f64>();
