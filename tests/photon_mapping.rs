@@ -367,3 +367,22 @@ fn photons_carry_the_skys_light_as_path_tracing_sees_it() {
     assert_same_energy(&image, &reference, "photon mapping under a sky", 0.01);
     assert_same_energy(&progressive, &reference, "SPPM under a sky", 0.01);
 }
+
+/// The seed reaches every kind of map: each kind's photons differ from one
+/// seed to the next (the seed, a salt and the kind are mixed into each
+/// photon's stream; mixed so that two seeds or two kinds never share one).
+#[test]
+fn every_kind_of_map_changes_with_the_seed() {
+    let world = World::new(&presets::preset("cornell").unwrap().unwrap());
+    for kind in [MapKind::Global, MapKind::Caustic, MapKind::Indirect, MapKind::All] {
+        let maps: Vec<Vec<[f32; 3]>> = (0..4)
+            .map(|seed| trace_photons(&world, kind, 2_000, 0, seed, 8).iter().map(|p| p.position.to_array()).collect())
+            .collect();
+        assert!(maps.iter().all(|m| !m.is_empty()), "{kind:?} stored nothing");
+        for a in 0..maps.len() {
+            for b in a + 1..maps.len() {
+                assert_ne!(maps[a], maps[b], "{kind:?}: seeds {a} and {b} gave the same photons");
+            }
+        }
+    }
+}
