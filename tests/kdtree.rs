@@ -30,7 +30,7 @@ fn tree_result(tree: &PhotonKdTree, q: Vec3, normal: Option<Vec3>, k: usize, max
     // every neighbour it keeps
     assert_eq!(visited > 0, k > 0 && !tree.is_empty() && max_radius >= 0.0);
     assert!(visited >= out.len());
-    assert_eq!(out.is_empty(), out.len() == 0);
+    assert_eq!(out.is_empty(), out.as_slice().is_empty());
     let photons = tree.photons();
     let mut d: Vec<f32> = out
         .as_slice()
