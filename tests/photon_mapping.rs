@@ -370,7 +370,7 @@ fn photons_carry_the_skys_light_as_path_tracing_sees_it() {
 
 /// The seed reaches every kind of map: each kind's photons differ from one
 /// seed to the next (the seed, a salt and the kind are mixed into each
-/// photon's stream; mixed so that two seeds or two kinds never share one).
+/// photon's random stream).
 #[test]
 fn every_kind_of_map_changes_with_the_seed() {
     let world = World::new(&presets::preset("cornell").unwrap().unwrap());
