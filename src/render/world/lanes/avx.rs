@@ -189,16 +189,14 @@ impl F8 {
                 .and(exponent.gt(F8::splat(0.0)));
             // A signalling NaN's x⁰ is NaN in libm
             let one = M8(_mm256_castsi256_ps(y_zero)).and(self.eq(self));
-            let answered = fast.or(one).or(zero_base);
+            let pending = !fast.or(one).or(zero_base);
             let power = fast.select(power, one.select(F8::splat(1.0), F8::splat(0.0)));
-            if answered.bits() == (1 << LANES) - 1 {
+            if !pending.any() {
                 return power;
             }
             let (x, y, mut out) = (self.to_array(), exponent.to_array(), power.to_array());
-            for i in 0..LANES {
-                if answered.bits() >> i & 1 == 0 {
-                    out[i] = pow::powf(x[i], y[i]);
-                }
+            for i in pending.lanes() {
+                out[i] = pow::powf(x[i], y[i]);
             }
             F8::from_array(out)
         }
