@@ -56,6 +56,11 @@ fn left_subtree_size(n: usize) -> usize {
     (full - 1) / 2 + last.min(half_last)
 }
 
+/// Levels of a left-balanced tree of `n` nodes.
+fn depth_of(n: usize) -> usize {
+    (usize::BITS - n.leading_zeros()) as usize
+}
+
 /// Segments at least this long split their halves between threads.
 const PARALLEL_SEGMENT: usize = 1 << 16;
 
@@ -170,8 +175,7 @@ impl<P: KdPoint> KdTree<P> {
             photons.iter().enumerate().map(|(i, p)| Key { position: p.position(), record: i as u32 }).collect();
         let mut axes = vec![0u8; n];
         partition(&mut keys, &mut axes);
-        let depth = (usize::BITS - n.leading_zeros()) as usize;
-        Self { photons: to_heap_order(&photons, &keys, &axes), depth }
+        Self { photons: to_heap_order(&photons, &keys, &axes), depth: depth_of(n) }
     }
 
     /// A tree read back from a file, already in heap order; refused (with
@@ -200,8 +204,7 @@ impl<P: KdPoint> KdTree<P> {
                 }
             }
         }
-        let depth = (usize::BITS - n.leading_zeros()) as usize;
-        Ok(Self { photons, depth })
+        Ok(Self { photons, depth: depth_of(n) })
     }
 
     pub fn len(&self) -> usize {
