@@ -39,7 +39,7 @@ impl EmitterCap {
             ((to_other / d).as_vec3(), (r * r + d * d - big * big) / (2.0 * r * d))
         } else {
             // Concentric: all inside or nothing
-            (Vec3::Z, if r < big { -1.0 } else { 1.0 })
+            (Vec3::Z, if r <= big { -1.0 } else { 1.0 })
         };
         let one_minus_cos = (1.0 - cos_min).clamp(0.0, 2.0) as f32;
         if one_minus_cos >= 2.0 {
@@ -397,12 +397,14 @@ mod tests {
     /// A light sphere sharing its centre with the sphere it is cut to lies
     /// wholly inside a larger one and wholly outside a smaller one, with a
     /// finite frame either way (no direction to the other centre to divide
-    /// by). Radii equal are the boundary, where either answer is the sphere
-    /// itself: left untested, as the cut's `<` is there.
+    /// by). With radii equal it lies on the other, inside by |p − c_o| ≤
+    /// R_o: whole, not an empty cap that would leave a light sphere twinned
+    /// by an opaque one (a copied object) emitting from nowhere.
     #[test]
     fn a_concentric_cut_is_all_or_nothing() {
         let c = Vec3::new(1.0, -2.0, 3.0);
         assert!(EmitterCap::inside(c, 0.5, c, 2.0).is_whole());
+        assert!(EmitterCap::inside(c, 2.0, c, 2.0).is_whole());
         let none = EmitterCap::inside(c, 2.0, c, 0.5);
         assert_eq!(none.one_minus_cos, 0.0);
         assert!(none.frame.z.is_finite() && none.frame.x.is_finite());
@@ -410,6 +412,77 @@ mod tests {
         // sphere lies within √2 of a point at distance 1
         let half = EmitterCap::inside(c, 1.0, c + Vec3::X, 2f32.sqrt());
         assert!((half.one_minus_cos - 1.0).abs() < 1e-6 && (half.frame.z - Vec3::X).length() < 1e-6);
+    }
+
+    /// A plane cuts a sphere into the cap past it: about the plane's
+    /// inward normal, 1 − cos θ = 1 − (offset − n·c)/r; a sphere wholly
+    /// past the plane is whole, one wholly before it is empty.
+    #[test]
+    fn a_plane_cuts_the_cap_past_it() {
+        let c = Vec3::new(0.5, 2.0, -1.0);
+        // Inward +y, the plane y = 2.5: the cap above it, cos θ ≥ 0.5
+        let cap = EmitterCap::in_half_space(c, 1.0, Vec3::new(0.0, 3.0, 0.0), 2.5);
+        assert!(!cap.is_whole());
+        assert!((cap.one_minus_cos - 0.5).abs() < 1e-6 && (cap.frame.z - Vec3::Y).length() < 1e-6);
+        assert!((cap.area(1.0) - std::f32::consts::PI).abs() < 1e-5);
+        // Inward −y through the same plane (y < 2.5): the rest, 1 − cos = 1.5
+        let rest = EmitterCap::in_half_space(c, 1.0, -Vec3::Y, -2.5);
+        assert!((rest.one_minus_cos - 1.5).abs() < 1e-6 && (rest.frame.z + Vec3::Y).length() < 1e-6);
+        assert!(EmitterCap::in_half_space(c, 1.0, Vec3::Y, 0.5).is_whole());
+        assert_eq!(EmitterCap::in_half_space(c, 1.0, Vec3::Y, 3.5).one_minus_cos, 0.0);
+    }
+
+    /// A sphere emits only from its cap (light samples land nowhere else,
+    /// so a hit elsewhere must get no light pdf), and from all of it when
+    /// whole; a triangle from all of it.
+    #[test]
+    fn an_emitter_emits_from_its_cap_only() {
+        let (center, radius) = (Vec3::new(0.5, 2.0, -1.0), 2.0);
+        let cap = EmitterCap::in_half_space(center, radius, Vec3::Y, 1.0); // y > 1: 1 − cos θ = 1.5
+        let sphere = Emitter::Sphere { sphere: 0, center, radius, cap };
+        let on = |theta: f32| center + radius * Vec3::new(theta.sin(), theta.cos(), 0.0);
+        // cos θ ≥ −0.5: θ up to 120°
+        for (degrees, emits) in [(0.0, true), (60.0, true), (115.0, true), (125.0, false), (180.0, false)] {
+            assert_eq!(sphere.emits_at(on(f32::to_radians(degrees))), emits, "θ = {degrees}°");
+        }
+        let whole = Emitter::Sphere { sphere: 0, center, radius, cap: EmitterCap::WHOLE };
+        assert!(whole.emits_at(on(std::f32::consts::PI)));
+        assert!((sphere.area() - 2.0 * std::f32::consts::PI * 4.0 * 1.5).abs() < 1e-4);
+        let shape = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
+        let triangle = Emitter::Triangle { triangle: 0, shape };
+        assert!(triangle.emits_at(Vec3::new(0.25, 0.25, 0.0)));
+        assert_eq!(triangle.area(), 0.5);
+    }
+
+    /// The error bound of an emitter covers how far the points drawn on it
+    /// lie from its surface, measured in f64 (and they do stray: the bound
+    /// is needed): on smallpt's light, radius 600 with its centre near 700,
+    /// whole and cut, a small sphere far from the origin, and a triangle.
+    #[test]
+    fn emitter_points_lie_within_their_error_bound() {
+        use crate::render::world::emission::point_on_emitter;
+        let mut sampler = Sampler::new(5, 0, 11);
+        let mut check = |emitter: Emitter, distance: &dyn Fn(Vec3) -> f64| {
+            let mut worst = 0.0f64;
+            for _ in 0..20_000 {
+                let (point, _, error) = point_on_emitter(&emitter, sampler.next_2d());
+                let off = distance(point);
+                assert!(off <= error as f64, "{emitter:?}: {point} lies {off:e} off, bound {error:e}");
+                worst = worst.max(off);
+            }
+            assert!(worst > 0.0, "{emitter:?}: every point exact");
+        };
+        for (center, radius) in [(Vec3::new(50.0, 681.33, 81.6), 600.0), (Vec3::new(-300.0, 2.0, 1000.0), 0.125)] {
+            let cut = EmitterCap::in_half_space(center, radius, Vec3::Y, center.y - 0.5 * radius);
+            for cap in [EmitterCap::WHOLE, cut] {
+                let sphere = Emitter::Sphere { sphere: 0, center, radius, cap };
+                check(sphere, &|p| ((p.as_dvec3() - center.as_dvec3()).length() - radius as f64).abs());
+            }
+        }
+        let [a, b, c] = [Vec3::new(-40.0, 3.0, 7.5), Vec3::new(-39.0, 3.5, 7.0), Vec3::new(-40.5, 4.0, 8.0)];
+        let normal = (b - a).as_dvec3().cross((c - a).as_dvec3()).normalize();
+        let triangle = Emitter::Triangle { triangle: 0, shape: Triangle::new(a, b, c) };
+        check(triangle, &|p| normal.dot(p.as_dvec3() - a.as_dvec3()).abs());
     }
 
     /// smallpt's light is a sphere of radius 600 poking 0.27 through the
