@@ -485,6 +485,63 @@ mod tests {
         check(triangle, &|p| normal.dot(p.as_dvec3() - a.as_dvec3()).abs());
     }
 
+    /// Point and spot lights give I·att(d) (times the spot factor) toward
+    /// the light, with an infinite pdf; a spot gives nothing outside its
+    /// cone. Only area lights and the background are not deltas.
+    #[test]
+    fn delta_lights_give_their_closed_forms() {
+        let at = SurfaceHit { t: 1.0, point: Vec3::new(0.5, -1.0, 2.0), normal: Vec3::Y, error: 0.0 };
+        let position = Vec3::new(1.5, 2.0, 0.0);
+        let (d, wi) = ((position - at.point).length(), (position - at.point).normalize());
+        let (intensity, attenuation) = (Rgb::new(3.0, 2.0, 1.0), Attenuation { a: 1.0, b: 0.5, c: 0.25 });
+        let att = 1.0 / (d * d + 0.5 * d + 0.25);
+        let close = |a: Rgb, b: Rgb| (a - b).abs().max_element() <= 1e-5 * b.max_element();
+        let point = LightSource::Point { position, intensity, attenuation };
+        let sample = point.sample(&at, Vec2::ZERO).expect("a point light always samples");
+        // (the shadow ray starts a hair off the surface)
+        assert!(
+            close(sample.value, intensity * att) && (sample.wi - wi).length() < 1e-4,
+            "{:?} {}",
+            sample.value,
+            sample.wi
+        );
+        assert_eq!((sample.pdf, sample.point), (f32::INFINITY, position));
+        // A spot aimed past the point: cos 0.9 off its axis, exponent 3
+        let axis = Frame::from_z(-wi).to_world(Vec3::new((1.0f32 - 0.81).sqrt(), 0.0, 0.9));
+        let spot =
+            |cos_cone| LightSource::Spot { position, direction: axis, cos_cone, exponent: 3.0, intensity, attenuation };
+        let sample = spot(0.8).sample(&at, Vec2::ZERO).expect("inside the cone");
+        assert!(close(sample.value, intensity * att * 0.9f32.powi(3)), "{:?}", sample.value);
+        assert!(spot(0.95).sample(&at, Vec2::ZERO).is_none());
+        let directional = LightSource::Directional { direction: -Vec3::Y, irradiance: intensity };
+        let background = LightSource::Background { radiance: intensity };
+        let shape = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Z);
+        let area =
+            LightSource::Area { object: 0, radiance: intensity, emitter: Emitter::Triangle { triangle: 0, shape } };
+        let deltas: Vec<bool> =
+            [point, spot(0.8), directional, background, area].iter().map(LightSource::is_delta).collect();
+        assert_eq!(deltas, [true, true, true, false, false]);
+    }
+
+    /// Area lights emit from their front only: a point behind a triangle
+    /// light gets no sample from it, one in front does.
+    #[test]
+    fn an_area_light_lights_only_its_front() {
+        // Normal (b − a) × (c − a) = +y
+        let shape = Triangle::new(Vec3::ZERO, Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 0.0));
+        assert!(shape.normal.y > 0.99);
+        let light =
+            LightSource::Area { object: 0, radiance: Rgb::ONE, emitter: Emitter::Triangle { triangle: 0, shape } };
+        let hit = |y: f32| SurfaceHit { t: 1.0, point: Vec3::new(0.3, y, 0.3), normal: Vec3::Y, error: 0.0 };
+        let mut sampler = Sampler::new(3, 0, 5);
+        for _ in 0..100 {
+            let u = sampler.next_2d();
+            assert!(light.sample(&hit(-1.0), u).is_none(), "lit from behind");
+            let front = light.sample(&hit(1.0), u).expect("lit in front");
+            assert!(front.pdf > 0.0 && front.value.is_finite() && front.wi.y < 0.0);
+        }
+    }
+
     /// smallpt's light is a sphere of radius 600 poking 0.27 through the
     /// ceiling. Light samples taken in the room land on the part under the
     /// ceiling and reach the light; sampling the light's part near the room
