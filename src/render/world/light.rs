@@ -361,10 +361,10 @@ impl LightSource {
             Emitter::Sphere { center, radius, cap, .. } => {
                 if !cap.is_whole() {
                     // Light sampling reaches only the cap: elsewhere its pdf is 0
-                    let normal = (hit.point - center) / radius;
-                    if normal.dot(cap.frame.z) < 1.0 - cap.one_minus_cos {
+                    if !emitter.emits_at(hit.point) {
                         return 0.0;
                     }
+                    let normal = (hit.point - center) / radius;
                     return solid_angle_pdf(p, hit.point, normal, cap.area(radius));
                 }
                 let distance2 = (center - p).length_squared();
