@@ -248,3 +248,22 @@ fn a_floor_under_a_white_sky_reflects_its_albedo() {
         }
     }
 }
+
+/// An empty scene under a sky is the sky, in every pixel and exactly, by
+/// every algorithm: a camera ray that meets nothing sees the background
+/// whole (no strategy but the camera's can reach a pinhole), and there is
+/// nothing for light to bounce off. It is also the one world the eight
+/// lanes do not take, so path tracing's one-at-a-time tracer draws it.
+#[test]
+fn an_empty_scene_is_its_sky() {
+    let sky = Vec3::new(0.25, 0.5, 1.5);
+    let mut scene = floor_scene(0.5, vec![]);
+    scene.objects.clear();
+    scene.background = sky;
+    for algorithm in Algorithm::ALL {
+        let (image, _) = common::render(&scene, settings(algorithm, 8, 6, 2));
+        for (i, pixel) in image.pixels.iter().enumerate() {
+            assert_eq!(*pixel, sky.to_array(), "{algorithm}, pixel {i}");
+        }
+    }
+}
