@@ -335,6 +335,7 @@ impl Bsdf {
 mod tests {
     use super::*;
     use crate::render::world::sampling::uniform_sphere;
+    use std::f32::consts::FRAC_PI_2;
 
     fn directional_albedo(bsdf: &Bsdf, wo: Vec3, n: usize) -> Rgb {
         let mut s = Sampler::new(0, 0, 5);
@@ -405,5 +406,102 @@ mod tests {
         let (f, t, _) = refract(wo, Vec3::Z, 1.5, 1.0);
         assert_eq!(f, 1.0);
         assert!(t.is_none());
+    }
+
+    /// A random unit vector and one in the hemisphere around it.
+    fn unit_and_front(s: &mut Sampler) -> (Vec3, Vec3) {
+        let n = uniform_sphere(s.next_2d());
+        let w = uniform_sphere(s.next_2d());
+        (n, if w.dot(n) < 0.0 { -w } else { w })
+    }
+
+    #[test]
+    fn reflection_mirrors_about_the_normal() {
+        let r = reflect(Vec3::new(1.0, 2.0, 0.0).normalize(), Vec3::Y);
+        assert!((r - Vec3::new(-1.0, 2.0, 0.0).normalize()).length() < 1e-6, "{r}");
+        let mut s = Sampler::new(3, 3, 3);
+        for _ in 0..1000 {
+            let (n, w) = unit_and_front(&mut s);
+            let r = reflect(w, n);
+            // Same angle to the normal, same length, and w + r along the normal
+            assert!((r.dot(n) - w.dot(n)).abs() < 1e-5 && (r.length() - 1.0).abs() < 1e-5, "{w} about {n}: {r}");
+            assert!((w + r).cross(n).length() < 1e-5, "{w} about {n}: {r}");
+        }
+    }
+
+    /// Fresnel's equations in the angles (Born and Wolf), in f64: the
+    /// reflectance `refract` gives, entering glass and leaving it below the
+    /// critical angle; the parallel part vanishes at Brewster's angle.
+    #[test]
+    fn fresnel_is_the_angle_form() {
+        let oracle = |theta_i: f64, eta_i: f64, eta_t: f64| {
+            let theta_t = (eta_i / eta_t * theta_i.sin()).asin();
+            let (d, s) = (theta_i - theta_t, theta_i + theta_t);
+            ((d.sin() / s.sin()).powi(2) + (d.tan() / s.tan()).powi(2)) / 2.0
+        };
+        for (eta_i, eta_t) in [(1.0f32, 1.5f32), (1.5, 1.0), (1.0, 2.4)] {
+            let critical = if eta_i > eta_t { (eta_t / eta_i).asin() } else { FRAC_PI_2 };
+            for k in 1..40 {
+                let theta = critical * k as f32 / 40.0;
+                let wo = Vec3::new(theta.sin(), 0.0, theta.cos());
+                let (fresnel, _, _) = refract(wo, Vec3::Z, eta_i, eta_t);
+                let expected = oracle(theta as f64, eta_i as f64, eta_t as f64);
+                assert!(
+                    (fresnel as f64 - expected).abs() < 1e-5,
+                    "{eta_i}→{eta_t} at {theta}: {fresnel} vs {expected}"
+                );
+            }
+            // At Brewster's angle only the perpendicular part is left
+            let brewster = (eta_t / eta_i).atan();
+            let wo = Vec3::new(brewster.sin(), 0.0, brewster.cos());
+            let (fresnel, _, _) = refract(wo, Vec3::Z, eta_i, eta_t);
+            let theta_t = (eta_i / eta_t * brewster.sin()).asin();
+            let perpendicular = ((brewster - theta_t).sin() / (brewster + theta_t).sin()).powi(2);
+            assert!((fresnel - perpendicular / 2.0).abs() < 1e-5, "{eta_i}→{eta_t} at Brewster: {fresnel}");
+        }
+    }
+
+    /// Snell: η_i sin θ_i = η_t sin θ_t, in the plane of incidence, through
+    /// to the other side; total internal reflection just past the critical
+    /// angle and not just before it.
+    #[test]
+    fn refraction_obeys_snell() {
+        let mut s = Sampler::new(4, 4, 4);
+        for (eta_i, eta_t) in [(1.0f32, 1.5f32), (1.5, 1.0), (1.33, 1.0)] {
+            let mut refracted = 0;
+            for _ in 0..2000 {
+                let (n, wo) = unit_and_front(&mut s);
+                let (_, t, eta) = refract(wo, n, eta_i, eta_t);
+                assert_eq!(eta, eta_i / eta_t);
+                let sin_i = wo.cross(n).length();
+                let Some(t) = t else {
+                    assert!(eta_i * sin_i > eta_t * (1.0 - 1e-4), "reflected at sin θ {sin_i}, {eta_i}→{eta_t}");
+                    continue;
+                };
+                refracted += 1;
+                assert!((t.length() - 1.0).abs() < 1e-5 && t.dot(n) < 0.0, "{t}");
+                assert!((eta_i * sin_i - eta_t * t.cross(n).length()).abs() < 1e-4, "{wo} → {t} about {n}");
+                assert!(wo.cross(n).dot(t).abs() < 1e-5, "{t} leaves the plane of {wo} and {n}");
+            }
+            assert!(refracted > 500, "{refracted} refracted, {eta_i}→{eta_t}");
+            if eta_i > eta_t {
+                let critical = (eta_t / eta_i).asin();
+                let at = |theta: f32| refract(Vec3::new(theta.sin(), 0.0, theta.cos()), Vec3::Z, eta_i, eta_t).1;
+                assert!(at(critical * 0.999).is_some() && at(critical * 1.001).is_none());
+            }
+        }
+    }
+
+    /// The diffuse lobe is chosen by its share of the luminance (Rec. 709).
+    #[test]
+    fn the_diffuse_lobe_is_chosen_by_its_luminance_share() {
+        let (red, green, blue) = (Vec3::X, Vec3::Y, Vec3::Z);
+        let share = Bsdf::diffuse_probability(red, green);
+        assert!((share - 0.2126 / (0.2126 + 0.7152)).abs() < 1e-6, "{share}");
+        let share = Bsdf::diffuse_probability(blue * 2.0, red);
+        assert!((share - 0.1444 / (0.1444 + 0.2126)).abs() < 1e-6, "{share}");
+        assert_eq!(Bsdf::diffuse_probability(blue, Vec3::ZERO), 1.0);
+        assert_eq!(Bsdf::diffuse_probability(Vec3::ZERO, green), 0.0);
+        assert_eq!(Bsdf::diffuse_probability(Vec3::ZERO, Vec3::ZERO), 1.0);
     }
 }
