@@ -504,4 +504,22 @@ mod tests {
         assert_eq!(Bsdf::diffuse_probability(Vec3::ZERO, green), 0.0);
         assert_eq!(Bsdf::diffuse_probability(Vec3::ZERO, Vec3::ZERO), 1.0);
     }
+
+    /// Giesen's normalisation makes the Blinn–Phong lobe reflect all it
+    /// receives at normal incidence: 2π ∫ N cosⁿ(θ/2) cos θ sin θ dθ = 1
+    /// (the half vector lies halfway to the normal), by Simpson's rule in f64.
+    #[test]
+    fn blinn_phong_reflects_everything_at_normal_incidence() {
+        for exponent in [0.5f32, 1.0, 4.0, 10.0, 100.0, 1000.0] {
+            let normalisation = blinn_normalisation(exponent) as f64;
+            let f = |theta: f64| normalisation * (theta / 2.0).cos().powf(exponent as f64) * theta.cos() * theta.sin();
+            let steps = 20_000;
+            let h = std::f64::consts::FRAC_PI_2 / steps as f64;
+            let simpson: f64 = (0..=steps)
+                .map(|i| f(i as f64 * h) * if i == 0 || i == steps { 1.0 } else { (2 + 2 * (i % 2)) as f64 })
+                .sum();
+            let albedo = 2.0 * std::f64::consts::PI * simpson * h / 3.0;
+            assert!((albedo - 1.0).abs() < 1e-5, "exponent {exponent}: {albedo}");
+        }
+    }
 }
