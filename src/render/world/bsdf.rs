@@ -522,4 +522,47 @@ mod tests {
             assert!((albedo - 1.0).abs() < 1e-5, "exponent {exponent}: {albedo}");
         }
     }
+
+    /// ∫ g(wi) dωi over the hemisphere about +z, by the midpoint rule in
+    /// (cos θ, φ) (where dω = d cos θ dφ), in f64.
+    fn over_the_hemisphere(g: impl Fn(Vec3) -> f64) -> f64 {
+        let (rings, sectors) = (1200, 64);
+        let mut sum = 0.0;
+        for i in 0..rings {
+            let cos = (i as f64 + 0.5) / rings as f64;
+            let sin = (1.0 - cos * cos).sqrt();
+            for j in 0..sectors {
+                let phi = (j as f64 + 0.5) / sectors as f64 * std::f64::consts::TAU;
+                sum += g(Vec3::new((sin * phi.cos()) as f32, (sin * phi.sin()) as f32, cos as f32));
+            }
+        }
+        sum * std::f64::consts::TAU / (rings * sectors) as f64
+    }
+
+    /// At normal incidence every glossy lobe lies above the surface: the
+    /// normalised lobes reflect all they receive (ks = 1), the diffuse part
+    /// its kd, and the sampling pdf integrates to 1 for Phong, whose lobe is
+    /// about the normal, and for Blinn–Phong to the diffuse share plus the
+    /// half vectors within 45° of the normal, 1 − cos^(n+1)(π/4).
+    #[test]
+    fn glossy_lobes_at_normal_incidence() {
+        let n = Vec3::Z;
+        let luminance_share = |kd: f32, ks: f32| kd / (kd + ks);
+        for exponent in [1.0f32, 10.0, 40.0] {
+            for (kd, ks) in [(0.0f32, 1.0f32), (0.5, 0.0), (0.3, 0.6)] {
+                let phong = Bsdf::Phong { kd: Vec3::splat(kd), ks: Vec3::splat(ks), exponent };
+                let blinn = Bsdf::BlinnPhong { kd: Vec3::splat(kd), ks: Vec3::splat(ks), exponent };
+                let pd = luminance_share(kd, ks) as f64;
+                let blinn_reach = 1.0 - std::f64::consts::FRAC_1_SQRT_2.powf(exponent as f64 + 1.0);
+                for (bsdf, pdf_total) in [(phong, 1.0), (blinn, pd + (1.0 - pd) * blinn_reach)] {
+                    let albedo = over_the_hemisphere(|wi| (bsdf.eval(n, wi, n).x * wi.z) as f64);
+                    let pdf = over_the_hemisphere(|wi| bsdf.pdf(n, wi, n) as f64);
+                    let what = format!("{bsdf:?}");
+                    // The quadrature's own error here is below 5e-5
+                    assert!((albedo - (kd + ks) as f64).abs() < 5e-4, "{what}: albedo {albedo}");
+                    assert!((pdf - pdf_total).abs() < 5e-4, "{what}: pdf integrates to {pdf}, not {pdf_total}");
+                }
+            }
+        }
+    }
 }
