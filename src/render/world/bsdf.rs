@@ -565,4 +565,60 @@ mod tests {
             }
         }
     }
+
+    /// A glass sample says how likely its own choice was: F for the
+    /// reflection, 1 − F for the refraction (what a bidirectional method's
+    /// reverse density reads), and chooses them that often.
+    #[test]
+    fn glass_samples_carry_the_chance_of_their_lobe() {
+        let glass = Bsdf::Glass { ior: 1.5, tint: Vec3::ONE };
+        let mut s = Sampler::new(5, 5, 5);
+        for (wo, n) in [(Vec3::new(0.6, 0.0, 0.8), Vec3::Z), (Vec3::new(0.3, 0.0, -0.953_939_2), Vec3::Z)] {
+            let facing = if wo.dot(n) < 0.0 { -n } else { n };
+            let (eta_i, eta_t) = if wo.dot(n) > 0.0 { (1.0, 1.5) } else { (1.5, 1.0) };
+            let (fresnel, refracted, _) = refract(wo, facing, eta_i, eta_t);
+            let refracted = refracted.expect("below the critical angle");
+            let trials = 20_000;
+            let mut reflections = 0;
+            for _ in 0..trials {
+                let b = glass.sample(wo, n, &mut s, Transport::Importance).expect("glass always scatters");
+                assert!(b.delta);
+                if b.wi == reflect(wo, facing) {
+                    reflections += 1;
+                    assert_eq!(b.pdf, fresnel);
+                } else {
+                    assert_eq!((b.wi, b.pdf), (refracted, 1.0 - fresnel));
+                }
+            }
+            // Binomial: 5 standard deviations
+            let sigma = (trials as f32 * fresnel * (1.0 - fresnel)).sqrt();
+            assert!(
+                (reflections as f32 - trials as f32 * fresnel).abs() < 5.0 * sigma,
+                "{reflections} of {trials}, F = {fresnel}"
+            );
+        }
+    }
+
+    /// Russian roulette's chance to go on: the largest reflectance, at most 1.
+    #[test]
+    fn continuation_is_the_largest_reflectance() {
+        let c = |bsdf: Bsdf| bsdf.continuation();
+        assert_eq!(c(Bsdf::Lambert { albedo: Vec3::new(0.2, 0.7, 0.4) }), 0.7);
+        let (kd, ks) = (Vec3::new(0.25, 0.5, 0.125), Vec3::new(0.5, 0.125, 0.125));
+        assert_eq!(c(Bsdf::Phong { kd, ks, exponent: 8.0 }), 0.75);
+        assert_eq!(c(Bsdf::BlinnPhong { kd: Vec3::splat(0.8), ks: Vec3::splat(0.5), exponent: 8.0 }), 1.0);
+        assert_eq!(c(Bsdf::Glass { ior: 1.5, tint: Vec3::new(0.9, 0.3, 0.3) }), 0.9);
+        assert_eq!(c(Bsdf::Black), 0.0);
+    }
+
+    /// Reflection only: nothing for a direction behind the surface, on
+    /// either side.
+    #[test]
+    fn nothing_is_reflected_from_behind() {
+        let phong = Bsdf::Phong { kd: Vec3::splat(0.3), ks: Vec3::splat(0.6), exponent: 2.0 };
+        let (front, behind) = (Vec3::new(0.3, 0.0, 0.95).normalize(), Vec3::new(0.3, 0.0, -0.95).normalize());
+        assert!(phong.eval_pdf(front, front, Vec3::Z).1 > 0.0);
+        assert_eq!(phong.eval_pdf(front, behind, Vec3::Z), (Rgb::ZERO, 0.0));
+        assert_eq!(phong.eval_pdf(behind, front, Vec3::Z), (Rgb::ZERO, 0.0));
+    }
 }
