@@ -211,3 +211,198 @@ pub fn emit_toward(
     };
     power.is_finite().then_some(EmittedPhoton { ray, power: power / pick })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{presets, Attenuation, Light, LightKind, MaterialModel, Object, Scene, Shape, ValidScene};
+
+    /// smallpt's room and balls without its light.
+    fn dark_smallpt() -> Scene {
+        let mut scene = presets::preset("smallpt").and_then(Result::ok).expect("smallpt").into_scene();
+        scene.objects.retain(|o| o.name != "light");
+        scene
+    }
+
+    fn light(kind: LightKind, color: Rgb, intensity: f32) -> Light {
+        let name = format!("test {} {color}", kind.kind_name());
+        Light { name, kind, color, intensity, attenuation: Attenuation::default(), enabled: true }
+    }
+
+    fn world(scene: Scene) -> World {
+        World::new(&ValidScene::new(scene).expect("a valid scene"))
+    }
+
+    /// Lights are picked by their power's luminance (Rec. 709), a dark one
+    /// never, and no index past them is.
+    #[test]
+    fn lights_are_picked_by_their_powers_luminance() {
+        let mut scene = dark_smallpt();
+        let at = LightKind::Point { position: Vec3::new(50.0, 60.0, 80.0) };
+        scene.lights = vec![light(at.clone(), Rgb::X, 2.0), light(at.clone(), Rgb::Z, 0.0), light(at, Rgb::Y, 1.0)];
+        let picker = LightPicker::new(&world(scene));
+        let red = 0.2126 * 2.0 / (0.2126 * 2.0 + 0.7152);
+        let p = [0, 1, 2, 3].map(|i| picker.probability(i));
+        assert!((p[0] - red).abs() < 1e-6 && (p[2] - (1.0 - red)).abs() < 1e-6 && p[1] == 0.0 && p[3] == 0.0, "{p:?}");
+        let (below, above) = (picker.pick(red * 0.999).unwrap(), picker.pick(red * 1.001).unwrap());
+        assert_eq!((below.0, above.0), (0, 2));
+        assert!((below.1 - p[0]).abs() < 1e-6 && (above.1 - p[2]).abs() < 1e-6);
+        assert_eq!(picker.pick(0.999_999).map(|(i, _)| i), Some(2));
+        assert!(!picker.is_empty() && LightPicker::new(&world(dark_smallpt())).is_empty());
+    }
+
+    /// A photon from a point light leaves it carrying the light's power,
+    /// 4π I, over the chance of picking the light.
+    #[test]
+    fn a_photon_carries_its_lights_power_over_its_pick() {
+        let mut scene = dark_smallpt();
+        let position = Vec3::new(50.0, 60.0, 80.0);
+        let color = Rgb::new(1.0, 0.5, 0.25);
+        scene.lights = vec![light(LightKind::Point { position }, color, 3.0)];
+        let twin =
+            Light { name: "twin".into(), ..light(LightKind::Point { position: position + Vec3::X }, color, 3.0) };
+        scene.lights.push(twin);
+        let world = world(scene);
+        let picker = LightPicker::new(&world);
+        let mut s = Sampler::new(0, 0, 1);
+        for _ in 0..100 {
+            let photon = emit(&world, &picker, &mut s).expect("a photon");
+            let expected = color * (3.0 * 4.0 * PI * 2.0);
+            assert!((photon.power - expected).abs().max_element() < 1e-5 * expected.max_element(), "{}", photon.power);
+            assert!(photon.ray.origin.distance(position) < 1.5 && (photon.ray.direction.length() - 1.0).abs() < 1e-5);
+        }
+    }
+
+    /// The caustic map's targets: bounding spheres of the mirror and glass
+    /// objects (a triangle's about its centroid, a hair larger), not of
+    /// planes, emitters or diffuse objects.
+    #[test]
+    fn specular_targets_bound_the_mirrors_and_the_glass() {
+        let mut scene = presets::preset("smallpt").and_then(Result::ok).expect("smallpt").into_scene();
+        let (a, b, c) = (Vec3::new(10.0, 10.0, 10.0), Vec3::new(16.0, 10.0, 10.0), Vec3::new(10.0, 19.0, 10.0));
+        let plane = Shape::Plane { point: Vec3::new(0.0, 80.0, 0.0), normal: -Vec3::Y };
+        scene.objects.push(Object {
+            name: "glass triangle".into(),
+            shape: Shape::Triangle { a, b, c },
+            material: "glass".into(),
+        });
+        scene.objects.push(Object { name: "mirror plane".into(), shape: plane, material: "mirror".into() });
+        let targets = specular_targets(&world(scene));
+        let centroid = (a + b + c) / 3.0;
+        let expected = [
+            (Vec3::new(27.0, 16.5, 47.0), 16.5),
+            (Vec3::new(73.0, 16.5, 78.0), 16.5),
+            (centroid, (c - centroid).length() * 1.001),
+        ];
+        assert_eq!(targets.len(), 3, "{targets:?}");
+        for ((center, radius), (c, r)) in targets.iter().zip(expected) {
+            assert!(center.distance(c) < 1e-4 && (radius - r).abs() < 1e-4, "{targets:?}");
+        }
+    }
+
+    /// Caustic photons of every kind of light, against the densities
+    /// written out in f64: each aims into a target's cone (or, from
+    /// afar, through its disc) and carries the light's output that way over
+    /// the density summed over every target that way.
+    #[test]
+    fn caustic_photons_aim_at_the_targets_with_their_share_of_power() {
+        let lamp_center = Vec3::new(50.0, 60.0, 81.6);
+        let (intensity, radiance, sky) = (3.0f32, 12.0f32, 0.5f32);
+        let down = Vec3::new(0.2, -1.0, 0.1).normalize();
+        let aim = (Vec3::new(27.0, 16.5, 47.0) - lamp_center).normalize();
+        let spot =
+            LightKind::Spot { position: lamp_center, direction: aim, cone_angle_degrees: 40.0, falloff_exponent: 2.0 };
+        let cases: [(&str, Option<LightKind>); 5] = [
+            ("point", Some(LightKind::Point { position: lamp_center })),
+            ("spot", Some(spot)),
+            ("directional", Some(LightKind::Directional { direction: down })),
+            ("area", None),
+            ("background", None),
+        ];
+        for (name, kind) in cases {
+            let mut scene = dark_smallpt();
+            // A third ball whose cone, seen from the lamp, overlaps the mirror ball's
+            let shape = Shape::Sphere { center: Vec3::new(40.0, 20.0, 50.0), radius: 8.0 };
+            scene.objects.push(Object { name: "small ball".into(), shape, material: "glass".into() });
+            match (name, kind) {
+                (_, Some(kind)) => scene.lights.push(light(kind, Rgb::ONE, intensity)),
+                ("area", None) => {
+                    let shape = Shape::Sphere { center: lamp_center, radius: 5.0 };
+                    scene.objects.push(Object { name: "lamp".into(), shape, material: "light".into() });
+                    assert!(matches!(
+                        scene.materials.iter().find(|m| m.name == "light").unwrap().model,
+                        MaterialModel::Emissive { .. }
+                    ));
+                }
+                _ => scene.background = Rgb::splat(sky),
+            }
+            let world = world(scene);
+            let (picker, targets) = (LightPicker::new(&world), specular_targets(&world));
+            assert_eq!((world.lights.len(), targets.len()), (1, 3), "{name}");
+            let share = 1.0 / targets.len() as f64;
+            // Solid-angle density of aiming `d` from `o`, and area density
+            // of a line along `d` through `o` crossing the targets' discs
+            let cones = |o: Vec3, d: Vec3| -> (f64, bool, usize) {
+                let (mut sum, mut on_edge, mut within) = (0.0, false, 0);
+                for (c, r) in &targets {
+                    let to = (*c - o).as_dvec3();
+                    let cos_max = (1.0 - (*r as f64 / to.length()).powi(2)).sqrt();
+                    let cos = to.normalize().dot(d.as_dvec3());
+                    on_edge |= (cos - cos_max).abs() < 1e-5;
+                    if cos >= cos_max {
+                        sum += share / (2.0 * std::f64::consts::PI * (1.0 - cos_max));
+                        within += 1;
+                    }
+                }
+                (sum, on_edge, within)
+            };
+            let discs = |o: Vec3, d: Vec3| -> (f64, bool, usize) {
+                let (mut sum, mut on_edge, mut within) = (0.0, false, 0);
+                for (c, r) in &targets {
+                    let to = (*c - o).as_dvec3();
+                    let off_axis = (to - d.as_dvec3() * to.dot(d.as_dvec3())).length();
+                    on_edge |= (off_axis / *r as f64 - 1.0).abs() < 1e-4;
+                    if off_axis <= *r as f64 {
+                        sum += share / (std::f64::consts::PI * (*r as f64).powi(2));
+                        within += 1;
+                    }
+                }
+                (sum, on_edge, within)
+            };
+            let mut s = Sampler::new(0, 0, 2);
+            let (mut emitted, mut overlapped) = (0, 0);
+            for _ in 0..4000 {
+                let Some(photon) = emit_toward(&world, &picker, &targets, &mut s) else { continue };
+                emitted += 1;
+                let (o, d) = (photon.ray.origin, photon.ray.direction);
+                let ((density, on_edge, within), output) = match name {
+                    "point" => (cones(o, d), intensity as f64),
+                    "spot" => (cones(o, d), (intensity * d.dot(aim).powf(2.0)) as f64),
+                    "directional" => (discs(o, d), intensity as f64),
+                    "background" => {
+                        let (density, on_edge, within) = discs(o, d);
+                        ((density / (4.0 * std::f64::consts::PI), on_edge, within), sky as f64)
+                    }
+                    _ => {
+                        let normal = (o - lamp_center).normalize();
+                        let area = 4.0 * std::f64::consts::PI * 25.0;
+                        (cones(o, d), radiance as f64 * normal.dot(d) as f64 * area)
+                    }
+                };
+                if on_edge {
+                    continue;
+                }
+                assert!(density > 0.0, "{name}: a photon from {o} along {d} misses every target");
+                overlapped += (within > 1) as usize;
+                let expected = output / density;
+                let got = photon.power.x as f64;
+                assert!((got / expected - 1.0).abs() < 1e-3, "{name}: power {got}, expected {expected}");
+                if name == "directional" {
+                    assert_eq!(d, down);
+                }
+            }
+            // Where two targets overlap, a photon's density is both's
+            assert!(emitted > 1000 && overlapped > 50, "{name}: {emitted} photons, {overlapped} through two targets");
+        }
+    }
+}
