@@ -333,6 +333,17 @@ mod tests {
         assert!(rel_mse(&spiked, &reference, RelMseOptions::default()).unwrap() > 1e3);
     }
 
+    /// Rejection never empties the mean: asking to drop every pixel keeps
+    /// the one with the smallest error.
+    #[test]
+    fn rejecting_everything_keeps_the_best_pixel() {
+        let reference = image(3, 1, |_, _| [1.0; 3]);
+        let test = image(3, 1, |x, _| [[3.0; 3], [1.5; 3], [2.0; 3]][x as usize]);
+        let all = RelMseOptions { reject_top_fraction: 1.0, ..Default::default() };
+        let best = 0.25 / (1.0 + RelMseOptions::default().epsilon);
+        assert!((rel_mse(&test, &reference, all).unwrap() - best).abs() < 1e-12);
+    }
+
     #[test]
     fn sizes_must_match() {
         let a = gradient();
