@@ -444,5 +444,11 @@ mod tests {
         assert_eq!(colours[3], FLAG_COLOUR);
         // An error map with no error (max 0) is all the bottom colour
         assert_eq!(false_colour(&[0.0, 0.5], 0.0), vec![[0, 0, 4, 255]; 2]);
+        // Values are read as fractions of `max`: half of it is the middle
+        // control point, and a sixteenth half way between the first two
+        let scaled = false_colour(&[0.0, 2.0, 0.25, 4.0, 8.0], 4.0);
+        assert_eq!(scaled[..2], [[0, 0, 4, 255], [181, 54, 122, 255]]);
+        assert_eq!(scaled[2], [14, 8, 36, 255]);
+        assert_eq!(scaled[3..], [[252, 253, 191, 255]; 2]);
     }
 }
