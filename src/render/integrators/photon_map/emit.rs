@@ -239,7 +239,8 @@ mod tests {
     fn lights_are_picked_by_their_powers_luminance() {
         let mut scene = dark_smallpt();
         let at = LightKind::Point { position: Vec3::new(50.0, 60.0, 80.0) };
-        scene.lights = vec![light(at.clone(), Rgb::X, 2.0), light(at.clone(), Rgb::Z, 0.0), light(at, Rgb::Y, 1.0)];
+        scene.lights =
+            vec![light(at.clone(), Rgb::X, 2.0), light(at.clone(), Rgb::Z, 0.0), light(at.clone(), Rgb::Y, 1.0)];
         let picker = LightPicker::new(&world(scene));
         let red = 0.2126 * 2.0 / (0.2126 * 2.0 + 0.7152);
         let p = [0, 1, 2, 3].map(|i| picker.probability(i));
@@ -248,6 +249,11 @@ mod tests {
         assert_eq!((below.0, above.0), (0, 2));
         assert!((below.1 - p[0]).abs() < 1e-6 && (above.1 - p[2]).abs() < 1e-6);
         assert_eq!(picker.pick(0.999_999).map(|(i, _)| i), Some(2));
+        // u = 1, past what a sampler draws: still a light, never a dark one
+        assert_eq!(picker.pick(1.0).map(|(i, _)| i), Some(2));
+        let mut dark_last = dark_smallpt();
+        dark_last.lights = vec![light(at.clone(), Rgb::X, 2.0), light(at.clone(), Rgb::Z, 0.0)];
+        assert!(LightPicker::new(&world(dark_last)).pick(1.0).is_none_or(|(_, p)| p > 0.0));
         assert!(!picker.is_empty() && LightPicker::new(&world(dark_smallpt())).is_empty());
     }
 
@@ -274,29 +280,28 @@ mod tests {
     }
 
     /// The caustic map's targets: bounding spheres of the mirror and glass
-    /// objects (a triangle's about its centroid, a hair larger), not of
-    /// planes, emitters or diffuse objects.
+    /// objects (a triangle's about its centroid, a hair larger, whichever
+    /// corner is farthest), not of planes, emitters or diffuse objects.
     #[test]
     fn specular_targets_bound_the_mirrors_and_the_glass() {
-        let mut scene = presets::preset("smallpt").and_then(Result::ok).expect("smallpt").into_scene();
         let (a, b, c) = (Vec3::new(10.0, 10.0, 10.0), Vec3::new(16.0, 10.0, 10.0), Vec3::new(10.0, 19.0, 10.0));
-        let plane = Shape::Plane { point: Vec3::new(0.0, 80.0, 0.0), normal: -Vec3::Y };
-        scene.objects.push(Object {
-            name: "glass triangle".into(),
-            shape: Shape::Triangle { a, b, c },
-            material: "glass".into(),
-        });
-        scene.objects.push(Object { name: "mirror plane".into(), shape: plane, material: "mirror".into() });
-        let targets = specular_targets(&world(scene));
         let centroid = (a + b + c) / 3.0;
-        let expected = [
-            (Vec3::new(27.0, 16.5, 47.0), 16.5),
-            (Vec3::new(73.0, 16.5, 78.0), 16.5),
-            (centroid, (c - centroid).length() * 1.001),
-        ];
-        assert_eq!(targets.len(), 3, "{targets:?}");
-        for ((center, radius), (c, r)) in targets.iter().zip(expected) {
-            assert!(center.distance(c) < 1e-4 && (radius - r).abs() < 1e-4, "{targets:?}");
+        for [a, b, c] in [[a, b, c], [c, a, b], [b, c, a]] {
+            let mut scene = presets::preset("smallpt").and_then(Result::ok).expect("smallpt").into_scene();
+            let plane = Shape::Plane { point: Vec3::new(0.0, 80.0, 0.0), normal: -Vec3::Y };
+            let triangle = Shape::Triangle { a, b, c };
+            scene.objects.push(Object { name: "glass triangle".into(), shape: triangle, material: "glass".into() });
+            scene.objects.push(Object { name: "mirror plane".into(), shape: plane, material: "mirror".into() });
+            let targets = specular_targets(&world(scene));
+            let expected = [
+                (Vec3::new(27.0, 16.5, 47.0), 16.5),
+                (Vec3::new(73.0, 16.5, 78.0), 16.5),
+                (centroid, (Vec3::new(10.0, 19.0, 10.0) - centroid).length() * 1.001),
+            ];
+            assert_eq!(targets.len(), 3, "{targets:?}");
+            for ((center, radius), (c, r)) in targets.iter().zip(expected) {
+                assert!(center.distance(c) < 1e-4 && (radius - r).abs() < 1e-4, "{targets:?}");
+            }
         }
     }
 
