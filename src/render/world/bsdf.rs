@@ -370,36 +370,6 @@ mod tests {
         }
     }
 
-    /// The sampler draws the directions its pdf says: the mean sampled
-    /// weight is the albedo integrated from `eval` (a lobe chosen with the
-    /// wrong probability biases it), within 5 standard errors of the mean
-    /// (one false alarm in 1.7 million).
-    #[test]
-    fn sampled_albedo_is_the_integrated_albedo() {
-        let mut s = Sampler::new(6, 6, 6);
-        for bsdf in [
-            Bsdf::Phong { kd: Vec3::splat(0.3), ks: Vec3::splat(0.6), exponent: 10.0 },
-            Bsdf::BlinnPhong { kd: Vec3::splat(0.2), ks: Vec3::splat(0.7), exponent: 30.0 },
-            Bsdf::Lambert { albedo: Vec3::splat(0.8) },
-        ] {
-            for wo in [Vec3::Z, Vec3::new(0.5, 0.2, 0.6).normalize()] {
-                let integrated = over_the_hemisphere(|wi| (bsdf.eval(wo, wi, Vec3::Z).x * wi.z) as f64);
-                let n = 40_000;
-                let weights: Vec<f64> = (0..n)
-                    .map(|_| bsdf.sample(wo, Vec3::Z, &mut s, Transport::Radiance).map_or(0.0, |b| b.weight.x as f64))
-                    .collect();
-                let mean = weights.iter().sum::<f64>() / n as f64;
-                let variance = weights.iter().map(|w| (w - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-                // The quadrature's own error is below 1e-4 (a Lambert weight has no variance)
-                let allowed = 5.0 * (variance / n as f64).sqrt() + 1e-4;
-                assert!(
-                    (mean - integrated).abs() < allowed,
-                    "{bsdf:?} at {wo}: sampled {mean}, integrated {integrated}"
-                );
-            }
-        }
-    }
-
     /// Where `front_constant` answers, it is `eval` for every direction in
     /// front, bit for bit, on either side of the surface; the lobes that
     /// depend on the direction do not answer.
