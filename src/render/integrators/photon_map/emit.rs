@@ -265,6 +265,7 @@ mod tests {
         let position = Vec3::new(50.0, 60.0, 80.0);
         let color = Rgb::new(1.0, 0.5, 0.25);
         scene.lights = vec![light(LightKind::Point { position }, color, 3.0)];
+        let alone = world(scene.clone());
         let twin =
             Light { name: "twin".into(), ..light(LightKind::Point { position: position + Vec3::X }, color, 3.0) };
         scene.lights.push(twin);
@@ -277,6 +278,20 @@ mod tests {
             assert!((photon.power - expected).abs().max_element() < 1e-5 * expected.max_element(), "{}", photon.power);
             assert!(photon.ray.origin.distance(position) < 1.5 && (photon.ray.direction.length() - 1.0).abs() < 1e-5);
         }
+        // A caustic photon too: the same draws from the first twin carry
+        // twice what they carry from it alone
+        let (targets, alone_picker) = (specular_targets(&world), LightPicker::new(&alone));
+        let mut twins = 0;
+        for i in 0..100 {
+            let (mut s, mut same) = (Sampler::new(i, 0, 2), Sampler::new(i, 0, 2));
+            let Some(photon) = emit_toward(&world, &picker, &targets, &mut s) else { continue };
+            if photon.ray.origin == position {
+                twins += 1;
+                let single = emit_toward(&alone, &alone_picker, &targets, &mut same).expect("the same photon");
+                assert_eq!(photon.power, single.power * 2.0);
+            }
+        }
+        assert!(twins > 20, "{twins} photons from the first twin");
     }
 
     /// The caustic map's targets: bounding spheres of the mirror and glass
