@@ -101,6 +101,17 @@ struct Occluder {
     emitter: Option<u32>,
 }
 
+/// What `PathLanes::nearest` finds for eight rays.
+struct LaneHits {
+    found: M8,
+    t: F8,
+    /// Spheres, then planes, then triangles: an index into `surfaces`.
+    shape: [i32; LANES],
+    point: V8,
+    normal: V8,
+    error: F8,
+}
+
 /// A world compiled for eight-lane path tracing.
 #[derive(Clone, Debug)]
 pub struct PathLanes {
@@ -316,87 +327,8 @@ impl PathLanes {
         counters.rays += active.count();
         let (origin, direction) = (st.origin, st.direction);
 
-        // Nearest sphere, in index order: ties keep the first, as
-        // `SphereLanes::nearest`; paths inside the walls meet them only on
-        // their way out, as `World::intersect_held`
         let held = st.inside_walls;
-        // Usually every path is inside the walls: then their near roots are never asked
-        let every_held = !active.and_not(held).any();
-        let mut t_hit = F8::splat(f32::INFINITY);
-        // The index in a float lane, counted there too: one blend per sphere
-        let mut index = F8::splat(0.0);
-        let mut k = F8::splat(0.0);
-        for sphere in &self.spheres {
-            let f = origin - V8::splat(sphere.center);
-            let radius2 = F8::splat(sphere.radius2);
-            let (t, closer) = match sphere.wall {
-                Some(wall) if held.any() => {
-                    let (anchor, normal) = (V8::splat(wall.anchor), V8::splat(wall.normal));
-                    let (t_exit, exits) = wall_exit(origin, direction, anchor, normal, F8::splat(wall.radius), t_hit);
-                    if every_held {
-                        (t_exit, exits)
-                    } else {
-                        let (t, closer, _) = nearest_root(f, direction, radius2, t_hit);
-                        (held.select(t_exit, t), held.select_mask(exits, closer))
-                    }
-                }
-                _ => {
-                    let (t, closer, _) = nearest_root(f, direction, radius2, t_hit);
-                    (t, closer)
-                }
-            };
-            t_hit = closer.select(t, t_hit);
-            index = closer.select(k, index);
-            k = k + 1.0;
-        }
-        // Planes: in index order for paths not held (`World::intersect`);
-        // for held ones the planes that are not walls, then the walls'
-        // ways out (`World::intersect_held`)
-        let first_plane = self.spheres.len() as f32;
-        let mut k = F8::splat(first_plane);
-        for plane in &self.planes {
-            if plane.wall.is_none() || !every_held {
-                let (normal, offset) = (V8::splat(plane.normal), F8::splat(plane.offset));
-                let (t, hits) = plane_t_of(origin, direction, normal, offset, t_hit);
-                let closer = if plane.wall.is_some() { hits.and_not(held) } else { hits };
-                t_hit = closer.select(t, t_hit);
-                index = closer.select(k, index);
-            }
-            k = k + 1.0;
-        }
-        if held.any() {
-            let mut k = F8::splat(first_plane);
-            for plane in &self.planes {
-                if let Some((inward, offset)) = plane.wall {
-                    let (t, exits) = plane_exit_of(origin, direction, V8::splat(inward), F8::splat(offset), t_hit);
-                    let closer = exits.and(held);
-                    t_hit = closer.select(t, t_hit);
-                    index = closer.select(k, index);
-                }
-                k = k + 1.0;
-            }
-        }
-        // Triangles last, as both do: the watertight test in the lanes
-        // whose ray may reach the triangle's ball
-        let first_triangle = first_plane + self.planes.len() as f32;
-        let (mut triangle_point, mut triangle_normal, mut triangle_error) =
-            (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
-        let shear = ray_shear_of(origin, direction);
-        for (j, triangle) in self.triangles.iter().enumerate() {
-            let near = self.may_reach(j, active, origin, direction, t_hit);
-            if !near.any() {
-                continue;
-            }
-            let (hits, t, point, error) = Self::triangle_hits(triangle, near, origin, direction, &shear, t_hit);
-            if hits.any() {
-                t_hit = hits.select(t, t_hit);
-                index = hits.select(F8::splat(first_triangle + j as f32), index);
-                triangle_point = hits.select_v(point, triangle_point);
-                triangle_normal = hits.select_v(V8::splat(triangle.normal), triangle_normal);
-                triangle_error = hits.select(error, triangle_error);
-            }
-        }
-        let found = active.and(t_hit.lt(F8::splat(f32::INFINITY)));
+        let LaneHits { found, t: t_hit, shape, point, normal, error } = self.nearest(active, held, origin, direction);
         let missed = active.and_not(found);
         let light_count = world.lights.len();
         let pick_pdf = 1.0 / light_count.max(1) as f32;
@@ -411,7 +343,6 @@ impl PathLanes {
         if !alive.any() {
             return missed;
         }
-        let shape = index.truncate();
         let surface: [&Surface; LANES] = lanes::each(|i| &self.surfaces[shape[i] as usize]);
         let code = F8::from_fn(|i| surface[i].kind);
         let kind = |k: f32| code.eq(F8::splat(k)).and(alive);
@@ -420,30 +351,6 @@ impl PathLanes {
         // What next-event estimation shades
         let diffuse = lambert.or(glossy.mask());
         let color = V8::from_fn(|i| surface[i].color);
-        let on_sphere = alive.and(index.lt(F8::splat(first_plane)));
-        let on_plane = alive.and_not(on_sphere).and(index.lt(F8::splat(first_triangle)));
-
-        let (mut point, mut normal, mut error) = (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
-        if on_sphere.any() {
-            self.sphere_hits(on_sphere, held, &shape, origin, direction, t_hit, &mut point, &mut normal, &mut error);
-        }
-        if on_plane.any() {
-            let last = self.planes.len() - 1;
-            let plane: [&PlaneInfo; LANES] =
-                lanes::each(|i| &self.planes[(shape[i] as usize).saturating_sub(self.spheres.len()).min(last)]);
-            let plane_normal = V8::from_fn(|i| plane[i].normal);
-            let offset = F8::from_fn(|i| plane[i].offset);
-            let (p, e) = plane_point_of(origin, direction, plane_normal, offset, t_hit);
-            point = on_plane.select_v(p, point);
-            normal = on_plane.select_v(plane_normal, normal);
-            error = on_plane.select(e, error);
-        }
-        let on_triangle = alive.and_not(index.lt(F8::splat(first_triangle)));
-        if on_triangle.any() {
-            point = on_triangle.select_v(triangle_point, point);
-            normal = on_triangle.select_v(triangle_normal, normal);
-            error = on_triangle.select(triangle_error, error);
-        }
         let wo = -direction;
         let hit = |i: usize| SurfaceHit {
             t: t_hit.lane(i),
@@ -575,6 +482,118 @@ impl PathLanes {
         st.direction = go.select_v(wi, st.direction);
         st.depth = st.depth.count_in(go);
         done.or(killed).or(go.and(st.depth.ge(max_depth)))
+    }
+
+    /// The nearest hit of each ray of `active` (`held` those inside every
+    /// wall): `World::intersect_held`, eight rays at a time, bit for bit.
+    #[inline(always)]
+    fn nearest(&self, active: M8, held: M8, origin: V8, direction: V8) -> LaneHits {
+        // Nearest sphere, in index order: ties keep the first, as
+        // `SphereLanes::nearest`; paths inside the walls meet them only on
+        // their way out, as `World::intersect_held`
+        // Usually every path is inside the walls: then their near roots are never asked
+        let every_held = !active.and_not(held).any();
+        let mut t_hit = F8::splat(f32::INFINITY);
+        // The index in a float lane, counted there too: one blend per sphere
+        let mut index = F8::splat(0.0);
+        let mut k = F8::splat(0.0);
+        for sphere in &self.spheres {
+            let f = origin - V8::splat(sphere.center);
+            let radius2 = F8::splat(sphere.radius2);
+            let (t, closer) = match sphere.wall {
+                Some(wall) if held.any() => {
+                    let (anchor, normal) = (V8::splat(wall.anchor), V8::splat(wall.normal));
+                    let (t_exit, exits) = wall_exit(origin, direction, anchor, normal, F8::splat(wall.radius), t_hit);
+                    if every_held {
+                        (t_exit, exits)
+                    } else {
+                        let (t, closer, _) = nearest_root(f, direction, radius2, t_hit);
+                        (held.select(t_exit, t), held.select_mask(exits, closer))
+                    }
+                }
+                _ => {
+                    let (t, closer, _) = nearest_root(f, direction, radius2, t_hit);
+                    (t, closer)
+                }
+            };
+            t_hit = closer.select(t, t_hit);
+            index = closer.select(k, index);
+            k = k + 1.0;
+        }
+        // Planes: in index order for paths not held (`World::intersect`);
+        // for held ones the planes that are not walls, then the walls'
+        // ways out (`World::intersect_held`)
+        let first_plane = self.spheres.len() as f32;
+        let mut k = F8::splat(first_plane);
+        for plane in &self.planes {
+            if plane.wall.is_none() || !every_held {
+                let (normal, offset) = (V8::splat(plane.normal), F8::splat(plane.offset));
+                let (t, hits) = plane_t_of(origin, direction, normal, offset, t_hit);
+                let closer = if plane.wall.is_some() { hits.and_not(held) } else { hits };
+                t_hit = closer.select(t, t_hit);
+                index = closer.select(k, index);
+            }
+            k = k + 1.0;
+        }
+        if held.any() {
+            let mut k = F8::splat(first_plane);
+            for plane in &self.planes {
+                if let Some((inward, offset)) = plane.wall {
+                    let (t, exits) = plane_exit_of(origin, direction, V8::splat(inward), F8::splat(offset), t_hit);
+                    let closer = exits.and(held);
+                    t_hit = closer.select(t, t_hit);
+                    index = closer.select(k, index);
+                }
+                k = k + 1.0;
+            }
+        }
+        // Triangles last, as both do: the watertight test in the lanes
+        // whose ray may reach the triangle's ball
+        let first_triangle = first_plane + self.planes.len() as f32;
+        let (mut triangle_point, mut triangle_normal, mut triangle_error) =
+            (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
+        let shear = ray_shear_of(origin, direction);
+        for (j, triangle) in self.triangles.iter().enumerate() {
+            let near = self.may_reach(j, active, origin, direction, t_hit);
+            if !near.any() {
+                continue;
+            }
+            let (hits, t, point, error) = Self::triangle_hits(triangle, near, origin, direction, &shear, t_hit);
+            if hits.any() {
+                t_hit = hits.select(t, t_hit);
+                index = hits.select(F8::splat(first_triangle + j as f32), index);
+                triangle_point = hits.select_v(point, triangle_point);
+                triangle_normal = hits.select_v(V8::splat(triangle.normal), triangle_normal);
+                triangle_error = hits.select(error, triangle_error);
+            }
+        }
+        let found = active.and(t_hit.lt(F8::splat(f32::INFINITY)));
+        let shape = index.truncate();
+        let on_sphere = found.and(index.lt(F8::splat(first_plane)));
+        let on_plane = found.and_not(on_sphere).and(index.lt(F8::splat(first_triangle)));
+
+        let (mut point, mut normal, mut error) = (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
+        if on_sphere.any() {
+            self.sphere_hits(on_sphere, held, &shape, origin, direction, t_hit, &mut point, &mut normal, &mut error);
+        }
+        if on_plane.any() {
+            let last = self.planes.len() - 1;
+            let plane: [&PlaneInfo; LANES] =
+                lanes::each(|i| &self.planes[(shape[i] as usize).saturating_sub(self.spheres.len()).min(last)]);
+            let plane_normal = V8::from_fn(|i| plane[i].normal);
+            let offset = F8::from_fn(|i| plane[i].offset);
+            let (p, e) = plane_point_of(origin, direction, plane_normal, offset, t_hit);
+            point = on_plane.select_v(p, point);
+            normal = on_plane.select_v(plane_normal, normal);
+            error = on_plane.select(e, error);
+        }
+        let on_triangle = found.and_not(index.lt(F8::splat(first_triangle)));
+        if on_triangle.any() {
+            point = on_triangle.select_v(triangle_point, point);
+            normal = on_triangle.select_v(triangle_normal, normal);
+            error = on_triangle.select(triangle_error, error);
+        }
+        LaneHits { found, t: t_hit, shape, point, normal, error }
     }
 
     /// The hits of lanes `on_sphere` (`shape` their sphere's index), rebuilt
