@@ -223,3 +223,20 @@ fn the_lanes_under_test_are_the_eight_lane_tracer() {
         "this CPU lacks AVX2: the lane tests would compare the scalar tracer with itself"
     );
 }
+
+/// Where smallpt's light, a ball poking through the ceiling, meets it: rays
+/// that reach both at the same distance, in f32, take the light, as
+/// `World::intersect_held` meets the walls after every other sphere. The
+/// lanes once took the ceiling, a wall, earlier in index order.
+#[test]
+fn the_seam_of_the_light_and_the_ceiling_bit_for_bit() {
+    let mut scene = preset("smallpt");
+    // The cap meets the ceiling (y = 81.6) on a circle of radius ~18 about x = 50
+    let rim = (600.0f32 * 600.0 - (681.33f32 - 81.6).powi(2)).sqrt();
+    scene.camera.position = Vec3::new(50.0, 40.0, 81.6);
+    scene.camera.look_at = Vec3::new(50.0 + rim, 81.6, 81.6);
+    scene.camera.near_clip = 0.0;
+    scene.camera.fov_y_degrees = 0.02;
+    let lit = assert_lanes_match_scalar(&scene, 4, 2);
+    assert!(lit > 100, "only {lit} samples carried light");
+}

@@ -498,27 +498,30 @@ impl PathLanes {
         let mut index = F8::splat(0.0);
         let mut k = F8::splat(0.0);
         for sphere in &self.spheres {
-            let f = origin - V8::splat(sphere.center);
-            let radius2 = F8::splat(sphere.radius2);
-            let (t, closer) = match sphere.wall {
-                Some(wall) if held.any() => {
-                    let (anchor, normal) = (V8::splat(wall.anchor), V8::splat(wall.normal));
-                    let (t_exit, exits) = wall_exit(origin, direction, anchor, normal, F8::splat(wall.radius), t_hit);
-                    if every_held {
-                        (t_exit, exits)
-                    } else {
-                        let (t, closer, _) = nearest_root(f, direction, radius2, t_hit);
-                        (held.select(t_exit, t), held.select_mask(exits, closer))
-                    }
-                }
-                _ => {
-                    let (t, closer, _) = nearest_root(f, direction, radius2, t_hit);
-                    (t, closer)
-                }
-            };
-            t_hit = closer.select(t, t_hit);
-            index = closer.select(k, index);
+            if sphere.wall.is_none() || !every_held {
+                let f = origin - V8::splat(sphere.center);
+                let (t, closer, _) = nearest_root(f, direction, F8::splat(sphere.radius2), t_hit);
+                let closer = if sphere.wall.is_some() { closer.and_not(held) } else { closer };
+                t_hit = closer.select(t, t_hit);
+                index = closer.select(k, index);
+            }
             k = k + 1.0;
+        }
+        // The walls' ways out for held paths, after every other sphere:
+        // a tie with one goes to the other sphere, as in `World::intersect_held`
+        if held.any() {
+            let mut k = F8::splat(0.0);
+            for sphere in &self.spheres {
+                if let Some(wall) = sphere.wall {
+                    let (anchor, normal, radius) =
+                        (V8::splat(wall.anchor), V8::splat(wall.normal), F8::splat(wall.radius));
+                    let (t, exits) = wall_exit(origin, direction, anchor, normal, radius, t_hit);
+                    let closer = exits.and(held);
+                    t_hit = closer.select(t, t_hit);
+                    index = closer.select(k, index);
+                }
+                k = k + 1.0;
+            }
         }
         // Planes: in index order for paths not held (`World::intersect`);
         // for held ones the planes that are not walls, then the walls'
