@@ -34,7 +34,7 @@ use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSource};
 use crate::render::world::sampling::{cosine_hemisphere_of, power_heuristic, power_heuristic_of, uniform_sphere_pdf};
-use crate::render::world::{ShapeRef, World};
+use crate::render::world::{Hit, ShapeRef, World};
 use crate::scene::{MaterialModel, Rgb};
 
 /// Bounces before Russian roulette may end a path (as in `path`).
@@ -245,6 +245,38 @@ impl PathLanes {
     /// x86-64), rather than falling back to the scalar tracer.
     pub fn runs_in_lanes() -> bool {
         lanes::supported()
+    }
+
+    /// The nearest hits of up to eight rays, each `held` or not as
+    /// `World::intersect_held` takes it: that function's hits, bit for bit,
+    /// from the paths' hit loop, for callers that go on lane by lane
+    /// (photon tracing). Fast only inlined into code built for AVX2.
+    #[inline(always)]
+    pub(crate) fn intersect8(&self, world: &World, rays: &[Option<(Ray, bool)>; LANES]) -> [Option<Hit>; LANES] {
+        let active = M8::from_fn(|i| rays[i].is_some());
+        let held = M8::from_fn(|i| rays[i].is_some_and(|(_, held)| held));
+        let ray = |i: usize| rays[i].map_or(Ray::new(Vec3::ZERO, Vec3::Z), |(ray, _)| ray);
+        let origin = V8::from_fn(|i| ray(i).origin);
+        let direction = V8::from_fn(|i| ray(i).direction);
+        let hits = self.nearest(active, held, origin, direction);
+        // Out of the registers first: the closure below does not inherit AVX2
+        let found = hits.found.bits();
+        let t = hits.t.to_array();
+        let error = hits.error.to_array();
+        let point = [hits.point.x.to_array(), hits.point.y.to_array(), hits.point.z.to_array()];
+        let normal = [hits.normal.x.to_array(), hits.normal.y.to_array(), hits.normal.z.to_array()];
+        lanes::each(|i| {
+            (found & 1 << i != 0).then(|| {
+                let object = self.surfaces[hits.shape[i] as usize].object;
+                let surface = SurfaceHit {
+                    t: t[i],
+                    point: Vec3::new(point[0][i], point[1][i], point[2][i]),
+                    normal: Vec3::new(normal[0][i], normal[1][i], normal[2][i]),
+                    error: error[i],
+                };
+                Hit { surface, object, material: world.objects[object as usize].material }
+            })
+        })
     }
 
     /// The radiance of every camera sample of `tile`, into `out` (one per sample).

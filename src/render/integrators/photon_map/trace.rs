@@ -2,17 +2,24 @@
 //! with Russian roulette at diffuse surfaces, and are stored at non-specular
 //! hits according to which map they are for. Photon i's random stream is
 //! fixed by (i, pass, seed), and chunks are joined in order, so the maps do
-//! not depend on the thread count.
+//! not depend on the thread count. Eight photons are traced at a time
+//! where the CPU and the world allow (`trace_lanes`), with the same bits.
 
+use std::ops::Range;
+
+use glam::Vec3;
 use rayon::prelude::*;
 
+use super::emit::{emit, emit_toward, specular_targets, EmittedPhoton, LightPicker};
+use super::record::Photon;
+use super::trace_lanes;
 use crate::faults::{self, Fault};
-
-use crate::render::integrators::photon_map::emit::{emit, emit_toward, specular_targets, EmittedPhoton, LightPicker};
-use crate::render::integrators::photon_map::record::Photon;
+use crate::geometry::Ray;
+use crate::render::integrators::path_lanes::PathLanes;
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::rng::Sampler;
-use crate::render::world::World;
+use crate::render::world::{Hit, World};
+use crate::scene::Rgb;
 
 /// Which photons a map keeps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -51,15 +58,11 @@ pub fn trace_photons_until(
     max_depth: u32,
     keep_going: &(dyn Fn() -> bool + Sync),
 ) -> Option<Vec<Photon>> {
-    let picker = LightPicker::new(world);
-    if picker.is_empty() || count == 0 {
+    let Some(tracing) = Tracing::new(world, kind, count, pass, seed, max_depth) else {
         return Some(Vec::new());
-    }
-    let targets = if kind == MapKind::Caustic { specular_targets(world) } else { Vec::new() };
-    if kind == MapKind::Caustic && targets.is_empty() {
-        return Some(Vec::new());
-    }
-    let scale = 1.0 / count as f32;
+    };
+    // Built once for all the chunks: None where the CPU or the world has no lanes
+    let lanes = PathLanes::new(world).filter(|_| PathLanes::runs_in_lanes());
     // usize: rayon splits only ranges of usize by index
     let chunks = count.div_ceil(CHUNK) as usize;
     let per_chunk: Option<Vec<Vec<Photon>>> = (0..chunks)
@@ -70,73 +73,137 @@ pub fn trace_photons_until(
                 return None;
             }
             let chunk = chunk as u64;
-            let mut stored = Vec::new();
-            for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(count) {
-                let mut sampler = Sampler::new(index, pass, seed ^ PHOTON_SALT ^ kind as u64);
-                let emitted = match kind {
-                    MapKind::Caustic => emit_toward(world, &picker, &targets, &mut sampler),
-                    _ => emit(world, &picker, &mut sampler),
-                };
-                if let Some(photon) = emitted {
-                    trace_one(world, kind, photon, scale, max_depth, &mut sampler, &mut stored);
-                }
-            }
-            Some(stored)
+            let indices = chunk * CHUNK..((chunk + 1) * CHUNK).min(count);
+            Some(match &lanes {
+                Some(lanes) => trace_lanes::trace_chunk(lanes, &tracing, indices),
+                None => tracing.trace_one_by_one(indices),
+            })
         })
         .collect();
     Some(per_chunk?.concat())
 }
 
-fn trace_one(
-    world: &World,
+/// What the photons of one call share.
+pub(super) struct Tracing<'a> {
+    world: &'a World,
     kind: MapKind,
-    emitted: EmittedPhoton,
+    picker: LightPicker,
+    /// Balls bounding the mirrors and glass (caustic maps only).
+    targets: Vec<(Vec3, f32)>,
+    /// 1 / the photon count: each stored power's share.
     scale: f32,
     max_depth: u32,
-    sampler: &mut Sampler,
-    stored: &mut Vec<Photon>,
-) {
-    let EmittedPhoton { mut ray, mut power } = emitted;
-    let held = world.holds(ray.origin);
-    power *= if faults::active(Fault::PhotonPowerHigh) { scale * 1.05 } else { scale };
-    let mut diffuse_bounces = 0;
-    for depth in 0..max_depth {
-        let Some(hit) = world.intersect_held(&ray, f32::INFINITY, held) else {
-            return;
+    pass: u64,
+    seed: u64,
+}
+
+/// One photon between its bounces.
+pub(super) struct Flight {
+    pub ray: Ray,
+    pub held: bool,
+    power: Rgb,
+    depth: u32,
+    diffuse_bounces: u32,
+    sampler: Sampler,
+}
+
+impl<'a> Tracing<'a> {
+    /// For `count` photons of map `kind`: None if there is nothing to
+    /// trace (no photons, no light, a caustic map without mirrors or glass).
+    pub(super) fn new(
+        world: &'a World,
+        kind: MapKind,
+        count: u64,
+        pass: u64,
+        seed: u64,
+        max_depth: u32,
+    ) -> Option<Self> {
+        let picker = LightPicker::new(world);
+        if picker.is_empty() || count == 0 {
+            return None;
+        }
+        let targets = if kind == MapKind::Caustic { specular_targets(world) } else { Vec::new() };
+        if kind == MapKind::Caustic && targets.is_empty() {
+            return None;
+        }
+        Some(Tracing { world, kind, picker, targets, scale: 1.0 / count as f32, max_depth, pass, seed })
+    }
+
+    pub(super) fn world(&self) -> &'a World {
+        self.world
+    }
+
+    /// Photon `index`, leaving its light: None if it leaves none, or may
+    /// not bounce at all.
+    pub(super) fn launch(&self, index: u64) -> Option<Flight> {
+        let world = self.world;
+        let mut sampler = Sampler::new(index, self.pass, self.seed ^ PHOTON_SALT ^ self.kind as u64);
+        let emitted = match self.kind {
+            MapKind::Caustic => emit_toward(world, &self.picker, &self.targets, &mut sampler),
+            _ => emit(world, &self.picker, &mut sampler),
         };
-        let bsdf = Bsdf::new(world.material_of(&hit));
+        let EmittedPhoton { ray, power } = emitted.filter(|_| self.max_depth > 0)?;
+        let scale = if faults::active(Fault::PhotonPowerHigh) { self.scale * 1.05 } else { self.scale };
+        let held = world.holds(ray.origin);
+        Some(Flight { ray, held, power: power * scale, depth: 0, diffuse_bounces: 0, sampler })
+    }
+
+    /// The photon's bounce at `hit`, the nearest along its ray: stored
+    /// there if its map keeps it, then scattered by the surface. False
+    /// once it goes no further.
+    pub(super) fn bounce(&self, flight: &mut Flight, hit: &Hit, store: &mut impl FnMut(Photon)) -> bool {
+        let kind = self.kind;
+        let bsdf = Bsdf::new(self.world.material_of(hit));
         if !bsdf.is_specular() {
             let keep = match kind {
-                MapKind::Global => diffuse_bounces > 0,
-                MapKind::Caustic => depth > 0,
-                MapKind::Indirect => depth > 0,
+                MapKind::Global => flight.diffuse_bounces > 0,
+                MapKind::Caustic => flight.depth > 0,
+                MapKind::Indirect => flight.depth > 0,
                 MapKind::All => true,
             };
-            if keep && power.is_finite() {
-                stored.push(Photon::new(hit.surface.point, ray.direction, power.to_array()));
+            if keep && flight.power.is_finite() {
+                store(Photon::new(hit.surface.point, flight.ray.direction, flight.power.to_array()));
             }
             if kind == MapKind::Caustic {
-                return;
+                return false;
             }
         }
-        let Some(scattered) = bsdf.sample(-ray.direction, hit.surface.normal, sampler, Transport::Importance) else {
-            return;
+        let sampler = &mut flight.sampler;
+        let Some(scattered) = bsdf.sample(-flight.ray.direction, hit.surface.normal, sampler, Transport::Importance)
+        else {
+            return false;
         };
         if !scattered.delta {
             if kind == MapKind::Caustic {
-                return;
+                return false;
             }
-            diffuse_bounces += 1;
+            flight.diffuse_bounces += 1;
             // Russian roulette with the surface's reflectance: survivors carry
             // the absorbed photons' share
             let survive = scattered.weight.max_element().min(1.0);
             if survive <= 0.0 || sampler.next_f32() >= survive {
-                return;
+                return false;
             }
-            power *= scattered.weight / survive;
+            flight.power *= scattered.weight / survive;
         } else {
-            power *= scattered.weight;
+            flight.power *= scattered.weight;
         }
-        ray = hit.surface.spawn_ray(scattered.wi);
+        flight.ray = hit.surface.spawn_ray(scattered.wi);
+        flight.depth += 1;
+        flight.depth < self.max_depth
+    }
+
+    /// The photons `indices`, one at a time: what they store, in order.
+    pub(super) fn trace_one_by_one(&self, indices: Range<u64>) -> Vec<Photon> {
+        let mut stored = Vec::new();
+        for index in indices {
+            let Some(mut flight) = self.launch(index) else { continue };
+            while let Some(hit) = self.world.intersect_held(&flight.ray, f32::INFINITY, flight.held) {
+                if !self.bounce(&mut flight, &hit, &mut |photon| stored.push(photon)) {
+                    break;
+                }
+            }
+        }
+        stored
     }
 }
