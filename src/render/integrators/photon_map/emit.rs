@@ -150,6 +150,24 @@ pub fn emit_toward(
         let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
         Some(Frame::from_z(to / distance2.sqrt()).to_world(uniform_cone(u2, one_minus_cos)))
     };
+    // Along `direction`, from a disc just covering the target across it,
+    // upstream of the scene: the origin, and the density of origins over
+    // every target's disc that holds this line
+    let from_upstream = |direction: Vec3| -> (Vec3, f32) {
+        let frame = Frame::from_z(direction);
+        let disc = crate::render::world::sampling::concentric_disk(u1) * target.1;
+        let origin =
+            target.0 - direction * (2.0 * world.bounds_radius.max(target.1)) + frame.x * disc.x + frame.y * disc.y;
+        let density = targets
+            .iter()
+            .filter(|(c, r)| {
+                let offset = *c - origin;
+                (offset - direction * offset.dot(direction)).length_squared() <= r * r
+            })
+            .map(|(_, r)| target_pick / (PI * r * r))
+            .sum();
+        (origin, density)
+    };
     let (ray, power) = match *light {
         LightSource::Point { position, intensity, .. } => {
             let d = cone_direction(position)?;
@@ -164,37 +182,13 @@ pub fn emit_toward(
             (Ray::new(position, d), intensity * (falloff / direction_pdf(position, d)))
         }
         LightSource::Directional { direction, irradiance } => {
-            // A disc just covering the target, perpendicular to the light
-            let frame = Frame::from_z(direction);
-            let disc = crate::render::world::sampling::concentric_disk(u1) * target.1;
-            let origin =
-                target.0 - direction * (2.0 * world.bounds_radius.max(target.1)) + frame.x * disc.x + frame.y * disc.y;
-            // Density of origins over all targets' discs containing this line
-            let density: f32 = targets
-                .iter()
-                .filter(|(c, r)| {
-                    let offset = *c - origin;
-                    (offset - direction * offset.dot(direction)).length_squared() <= r * r
-                })
-                .map(|(_, r)| target_pick / (PI * r * r))
-                .sum();
+            let (origin, density) = from_upstream(direction);
             (Ray::new(origin, direction), irradiance / density)
         }
         LightSource::Background { radiance } => {
-            // A random sky direction, and a disc just covering the target across it
+            // A random sky direction
             let direction = -uniform_sphere(u2);
-            let frame = Frame::from_z(direction);
-            let disc = crate::render::world::sampling::concentric_disk(u1) * target.1;
-            let origin =
-                target.0 - direction * (2.0 * world.bounds_radius.max(target.1)) + frame.x * disc.x + frame.y * disc.y;
-            let density: f32 = targets
-                .iter()
-                .filter(|(c, r)| {
-                    let offset = *c - origin;
-                    (offset - direction * offset.dot(direction)).length_squared() <= r * r
-                })
-                .map(|(_, r)| target_pick / (PI * r * r))
-                .sum();
+            let (origin, density) = from_upstream(direction);
             (Ray::new(origin, direction), radiance / (uniform_sphere_pdf() * density))
         }
         LightSource::Area { radiance, ref emitter, .. } => {
