@@ -3,6 +3,7 @@
 
 pub mod emit;
 pub mod file;
+mod flight;
 pub mod kdtree;
 pub mod maps;
 pub mod record;

@@ -5,41 +5,17 @@
 //! not depend on the thread count. Eight photons are traced at a time
 //! where the CPU and the world allow (`trace_lanes`), with the same bits.
 
-use std::ops::Range;
-
-use glam::Vec3;
 use rayon::prelude::*;
 
-use super::emit::{emit, emit_toward, specular_targets, EmittedPhoton, LightPicker};
+pub use super::flight::MapKind;
+use super::flight::Tracing;
 use super::record::Photon;
 use super::trace_lanes;
-use crate::faults::{self, Fault};
-use crate::geometry::Ray;
 use crate::render::integrators::path_lanes::PathLanes;
-use crate::render::world::bsdf::{Bsdf, Transport};
-use crate::render::world::rng::Sampler;
-use crate::render::world::{Hit, World};
-use crate::scene::Rgb;
-
-/// Which photons a map keeps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MapKind {
-    /// Jensen's global map for indirect light: stores after at least one
-    /// diffuse bounce (direct light is sampled, caustics have their own map).
-    Global,
-    /// Light → one or more specular bounces → the first diffuse surface.
-    Caustic,
-    /// SPPM: every non-specular hit but the first (direct light is sampled).
-    Indirect,
-    /// Every non-specular hit, direct ones included (for inspecting the
-    /// photon distribution itself).
-    All,
-}
+use crate::render::world::World;
 
 /// Photons a task traces: the unit of work a cancel waits for at most.
 pub const CHUNK: u64 = 4096;
-/// Keeps photon streams apart from camera streams with the same indices.
-const PHOTON_SALT: u64 = 0x5eed_f07f_0000_0001;
 
 /// Trace `count` photons for `kind`; stored powers are divided by `count`.
 pub fn trace_photons(world: &World, kind: MapKind, count: u64, pass: u64, seed: u64, max_depth: u32) -> Vec<Photon> {
@@ -81,129 +57,4 @@ pub fn trace_photons_until(
         })
         .collect();
     Some(per_chunk?.concat())
-}
-
-/// What the photons of one call share.
-pub(super) struct Tracing<'a> {
-    world: &'a World,
-    kind: MapKind,
-    picker: LightPicker,
-    /// Balls bounding the mirrors and glass (caustic maps only).
-    targets: Vec<(Vec3, f32)>,
-    /// 1 / the photon count: each stored power's share.
-    scale: f32,
-    max_depth: u32,
-    pass: u64,
-    seed: u64,
-}
-
-/// One photon between its bounces.
-pub(super) struct Flight {
-    pub ray: Ray,
-    pub held: bool,
-    power: Rgb,
-    depth: u32,
-    diffuse_bounces: u32,
-    sampler: Sampler,
-}
-
-impl<'a> Tracing<'a> {
-    /// For `count` photons of map `kind`: None if there is nothing to
-    /// trace (no photons, no light, a caustic map without mirrors or glass).
-    pub(super) fn new(
-        world: &'a World,
-        kind: MapKind,
-        count: u64,
-        pass: u64,
-        seed: u64,
-        max_depth: u32,
-    ) -> Option<Self> {
-        let picker = LightPicker::new(world);
-        if picker.is_empty() || count == 0 {
-            return None;
-        }
-        let targets = if kind == MapKind::Caustic { specular_targets(world) } else { Vec::new() };
-        if kind == MapKind::Caustic && targets.is_empty() {
-            return None;
-        }
-        Some(Tracing { world, kind, picker, targets, scale: 1.0 / count as f32, max_depth, pass, seed })
-    }
-
-    pub(super) fn world(&self) -> &'a World {
-        self.world
-    }
-
-    /// Photon `index`, leaving its light: None if it leaves none, or may
-    /// not bounce at all.
-    pub(super) fn launch(&self, index: u64) -> Option<Flight> {
-        let world = self.world;
-        let mut sampler = Sampler::new(index, self.pass, self.seed ^ PHOTON_SALT ^ self.kind as u64);
-        let emitted = match self.kind {
-            MapKind::Caustic => emit_toward(world, &self.picker, &self.targets, &mut sampler),
-            _ => emit(world, &self.picker, &mut sampler),
-        };
-        let EmittedPhoton { ray, power } = emitted.filter(|_| self.max_depth > 0)?;
-        let scale = if faults::active(Fault::PhotonPowerHigh) { self.scale * 1.05 } else { self.scale };
-        let held = world.holds(ray.origin);
-        Some(Flight { ray, held, power: power * scale, depth: 0, diffuse_bounces: 0, sampler })
-    }
-
-    /// The photon's bounce at `hit`, the nearest along its ray: stored
-    /// there if its map keeps it, then scattered by the surface. False
-    /// once it goes no further.
-    pub(super) fn bounce(&self, flight: &mut Flight, hit: &Hit, store: &mut impl FnMut(Photon)) -> bool {
-        let kind = self.kind;
-        let bsdf = Bsdf::new(self.world.material_of(hit));
-        if !bsdf.is_specular() {
-            let keep = match kind {
-                MapKind::Global => flight.diffuse_bounces > 0,
-                MapKind::Caustic => flight.depth > 0,
-                MapKind::Indirect => flight.depth > 0,
-                MapKind::All => true,
-            };
-            if keep && flight.power.is_finite() {
-                store(Photon::new(hit.surface.point, flight.ray.direction, flight.power.to_array()));
-            }
-            if kind == MapKind::Caustic {
-                return false;
-            }
-        }
-        let sampler = &mut flight.sampler;
-        let Some(scattered) = bsdf.sample(-flight.ray.direction, hit.surface.normal, sampler, Transport::Importance)
-        else {
-            return false;
-        };
-        if !scattered.delta {
-            if kind == MapKind::Caustic {
-                return false;
-            }
-            flight.diffuse_bounces += 1;
-            // Russian roulette with the surface's reflectance: survivors carry
-            // the absorbed photons' share
-            let survive = scattered.weight.max_element().min(1.0);
-            if survive <= 0.0 || sampler.next_f32() >= survive {
-                return false;
-            }
-            flight.power *= scattered.weight / survive;
-        } else {
-            flight.power *= scattered.weight;
-        }
-        flight.ray = hit.surface.spawn_ray(scattered.wi);
-        flight.depth += 1;
-        flight.depth < self.max_depth
-    }
-
-    /// The photons `indices`, one at a time: what they store, in order.
-    pub(super) fn trace_one_by_one(&self, indices: Range<u64>) -> Vec<Photon> {
-        let mut stored = Vec::new();
-        for index in indices {
-            let Some(mut flight) = self.launch(index) else { continue };
-            while let Some(hit) = self.world.intersect_held(&flight.ray, f32::INFINITY, flight.held) {
-                if !self.bounce(&mut flight, &hit, &mut |photon| stored.push(photon)) {
-                    break;
-                }
-            }
-        }
-        stored
-    }
 }

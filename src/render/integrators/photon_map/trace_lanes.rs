@@ -8,33 +8,33 @@
 
 use std::ops::Range;
 
+use super::flight::{Flight, Tracing};
 use super::record::Photon;
-use super::trace::{Flight, Tracing};
 use crate::render::integrators::path_lanes::PathLanes;
 use crate::render::world::lanes::{self, LANES};
 
 /// The photons `indices`, eight at a time: what they store, in photon
 /// order, as `Tracing::trace_one_by_one` stores it.
-pub(super) fn trace_chunk(lanes: &PathLanes, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
+pub(super) fn trace_chunk(path_lanes: &PathLanes, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
     if !PathLanes::runs_in_lanes() {
         return tracing.trace_one_by_one(indices);
     }
     #[cfg(target_arch = "x86_64")]
     // SAFETY: the CPU has AVX2 (`runs_in_lanes`).
     #[allow(unsafe_code)]
-    return unsafe { trace_chunk_avx2(lanes, tracing, indices) };
+    return unsafe { trace_chunk_avx2(path_lanes, tracing, indices) };
     #[cfg(not(target_arch = "x86_64"))]
-    trace_chunk_lanes(lanes, tracing, indices)
+    trace_chunk_lanes(path_lanes, tracing, indices)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn trace_chunk_avx2(lanes: &PathLanes, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
-    trace_chunk_lanes(lanes, tracing, indices)
+fn trace_chunk_avx2(path_lanes: &PathLanes, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
+    trace_chunk_lanes(path_lanes, tracing, indices)
 }
 
 #[inline(always)]
-fn trace_chunk_lanes(lanes: &PathLanes, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
+fn trace_chunk_lanes(path_lanes: &PathLanes, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
     let start = indices.start;
     // Each stored photon with its photon's place in the chunk
     let mut stored: Vec<(u32, Photon)> = Vec::new();
@@ -51,7 +51,7 @@ fn trace_chunk_lanes(lanes: &PathLanes, tracing: &Tracing, indices: Range<u64>) 
             break;
         }
         let rays = lanes::each(|i| flights[i].as_ref().map(|(_, f)| (f.ray, f.held)));
-        let hits = lanes.intersect8(tracing.world(), &rays);
+        let hits = path_lanes.intersect8(tracing.world(), &rays);
         for (slot, hit) in flights.iter_mut().zip(&hits) {
             let Some((place, flight)) = slot else { continue };
             let goes_on = match hit {
@@ -90,7 +90,7 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
-    use crate::render::integrators::photon_map::trace::MapKind;
+    use crate::render::integrators::photon_map::flight::MapKind;
     use crate::render::world::camera::CameraModel;
     use crate::render::world::World;
     use crate::scene::{presets, Attenuation, Light, LightKind, Rgb, Scene, ValidScene};
