@@ -10,6 +10,7 @@ pub mod path;
 pub mod path_lanes;
 pub mod photon;
 pub mod photon_map;
+pub mod reorder;
 pub mod specular;
 pub mod sppm;
 pub mod whitted;

@@ -2,15 +2,16 @@
 //! the paths' eight-lane hit loop (`PathLanes::intersect8`), and each
 //! photon bounces on by itself (`Tracing::bounce`), on its own random
 //! stream. A lane whose photon ends takes the next one, so the lanes stay
-//! busy however far photons go. What a chunk stores is sorted back into
-//! photon order, so the map is the one traced one photon at a time, bit for
-//! bit.
+//! busy however far photons go. What a chunk stores is put back into
+//! photon order (`reorder`), so the map is the one traced one photon at a
+//! time, bit for bit.
 
 use std::ops::Range;
 
 use super::flight::{Flight, Tracing};
 use super::record::Photon;
 use crate::render::integrators::path_lanes::PathLanes;
+use crate::render::integrators::reorder;
 use crate::render::world::lanes::{self, LANES};
 
 /// The photons `indices`, eight at a time: what they store, in photon
@@ -36,8 +37,8 @@ fn trace_chunk_avx2(path_lanes: &PathLanes, tracing: &Tracing, indices: Range<u6
 #[inline(always)]
 fn trace_chunk_lanes(path_lanes: &PathLanes, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
     let start = indices.start;
-    // Each stored photon with its photon's place in the chunk
-    let mut stored: Vec<(u32, Photon)> = Vec::new();
+    // Each stored photon, and its photon's place in the chunk
+    let (mut stored, mut places) = (Vec::new(), Vec::new());
     let mut flights: [Option<(u32, Flight)>; LANES] = Default::default();
     let mut next = indices.start;
     loop {
@@ -55,34 +56,16 @@ fn trace_chunk_lanes(path_lanes: &PathLanes, tracing: &Tracing, indices: Range<u
         for (slot, hit) in flights.iter_mut().zip(&hits) {
             let Some((place, flight)) = slot else { continue };
             let goes_on = match hit {
-                Some(hit) => tracing.bounce(flight, hit, &mut |photon| stored.push((*place, photon))),
+                Some(hit) => tracing.bounce(flight, hit, &mut |photon| stored.push(photon)),
                 None => false,
             };
+            places.resize(stored.len(), *place);
             if !goes_on {
                 *slot = None;
             }
         }
     }
-    in_photon_order(stored, (indices.end - start) as usize)
-}
-
-/// Records of photons `0..places` into photon order, keeping one photon's
-/// in the order of its bounces: a counting sort, as the places are few.
-fn in_photon_order(stored: Vec<(u32, Photon)>, places: usize) -> Vec<Photon> {
-    let mut first = vec![0usize; places + 1];
-    for (place, _) in &stored {
-        first[*place as usize + 1] += 1;
-    }
-    for i in 1..first.len() {
-        first[i] += first[i - 1];
-    }
-    let mut photons = vec![Photon::default(); stored.len()];
-    for (place, photon) in stored {
-        let at = &mut first[place as usize];
-        photons[*at] = photon;
-        *at += 1;
-    }
-    photons
+    reorder::by_item(&stored, &places, (indices.end - start) as usize).0
 }
 
 #[cfg(test)]
@@ -168,15 +151,5 @@ mod tests {
             // Smallpt's walls are spheres: what comes from outside stays outside
             assert!(stored > 200, "{name}: only {stored} photons stored");
         }
-    }
-
-    #[test]
-    fn records_come_out_in_photon_order_each_photons_in_bounce_order() {
-        let record = |x: f32| Photon::new(Vec3::splat(x), Vec3::Z, [1.0; 3]);
-        // Photon 2's three bounces, interleaved with photons 0 and 1's
-        let stored = [(2, 1.0), (0, 2.0), (2, 3.0), (1, 4.0), (2, 5.0), (0, 6.0)];
-        let sorted = in_photon_order(stored.iter().map(|&(p, x)| (p, record(x))).collect(), 4);
-        let xs: Vec<f32> = sorted.iter().map(|p| p.position.x).collect();
-        assert_eq!(xs, [2.0, 6.0, 4.0, 1.0, 3.0, 5.0]);
     }
 }
