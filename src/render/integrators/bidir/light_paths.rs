@@ -4,6 +4,11 @@
 //! and, where connecting is on, joined to the camera: a splat on the pixel
 //! it lands on. Path i's random stream is fixed by (i, pass, seed), and
 //! chunks are joined in order, so nothing depends on the thread count.
+//! Eight paths are traced at a time (their rays through the paths' hit
+//! loop, `PathLanes::intersect8`), and what they make is put back in path
+//! order, so nothing depends on how the lanes fell either.
+
+use std::ops::Range;
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -11,12 +16,16 @@ use rayon::prelude::*;
 use super::mis::{self, Partials};
 use super::strategies::{Contribution, PixelTally, Strategy, Tally};
 use super::Context;
-use crate::geometry::SurfaceHit;
+use crate::geometry::{Ray, SurfaceHit};
 use crate::render::film::Splat;
 use crate::render::integrators::next_event::PathScope;
-use crate::render::integrators::Counters;
+use crate::render::integrators::path_lanes::PathLanes;
+use crate::render::integrators::{reorder, Counters};
 use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::lanes::{self, LANES};
+use crate::render::world::light::LightSource;
 use crate::render::world::rng::Sampler;
+use crate::render::world::Hit;
 use crate::scene::Rgb;
 
 /// Light paths a task traces: the unit of work a cancel waits for at most.
@@ -76,7 +85,8 @@ impl LightPaths {
 }
 
 /// Trace `count` light subpaths of pass `pass`, asking `keep_going` before
-/// each chunk: None once it says no.
+/// each chunk: None once it says no. Eight at a time where the CPU and the
+/// world allow, with the same paths bit for bit.
 pub fn trace(
     ctx: &Context,
     count: u64,
@@ -84,6 +94,7 @@ pub fn trace(
     seed: u64,
     keep_going: &(dyn Fn() -> bool + Sync),
 ) -> Option<LightPaths> {
+    let path_lanes = PathLanes::new(ctx.world).filter(|_| PathLanes::runs_in_lanes());
     let chunks = count.div_ceil(CHUNK) as usize;
     let per_chunk: Option<Vec<ChunkPaths>> = (0..chunks)
         .into_par_iter()
@@ -92,13 +103,12 @@ pub fn trace(
             if !keep_going() {
                 return None;
             }
-            let mut out = ChunkPaths::default();
-            for index in chunk as u64 * CHUNK..((chunk as u64 + 1) * CHUNK).min(count) {
-                let mut sampler = Sampler::new(index, pass, seed ^ LIGHT_SALT);
-                trace_one(ctx, &mut sampler, &mut out);
-                out.ends.push(out.vertices.len() as u32);
-            }
-            Some(out)
+            let indices = chunk as u64 * CHUNK..((chunk as u64 + 1) * CHUNK).min(count);
+            let flights = Flights { ctx, pass, seed };
+            Some(match &path_lanes {
+                Some(path_lanes) => flights.trace_eight_at_a_time(path_lanes, indices),
+                None => flights.trace_one_by_one(indices),
+            })
         })
         .collect();
     let mut paths = LightPaths {
@@ -129,57 +139,178 @@ struct ChunkPaths {
     counters: Counters,
 }
 
-fn trace_one(ctx: &Context, sampler: &mut Sampler, out: &mut ChunkPaths) {
-    let (world, s) = (ctx.world, &ctx.strategies);
-    let Some((index, pick)) = ctx.picker.pick(sampler.next_f32()) else { return };
-    let light = &world.lights[index];
-    let (u1, u2) = (sampler.next_2d(), sampler.next_2d());
-    let emission = light.emit(ctx.bounds, u1, u2);
-    if !(emission.pdf > 0.0 && emission.power.is_finite()) {
-        return;
+/// One light subpath between its vertices.
+struct Flight<'w> {
+    sampler: Sampler,
+    scope: PathScope<'w>,
+    light: &'w LightSource,
+    pick: f32,
+    /// Where it left the light: the first hit's density by next-event
+    /// estimation needs it.
+    emitted_at: (Vec3, Vec3),
+    ray: Ray,
+    throughput: Rgb,
+    partials: Partials,
+    /// Segments from the light, `ray`'s included.
+    length: u32,
+}
+
+/// The light subpaths of one pass.
+struct Flights<'c, 'w> {
+    ctx: &'c Context<'w>,
+    pass: u64,
+    seed: u64,
+}
+
+impl<'w> Flights<'_, 'w> {
+    /// Path `index`, leaving its light: None if it leaves none.
+    fn launch(&self, index: u64) -> Option<Flight<'w>> {
+        let ctx = self.ctx;
+        let (world, s) = (ctx.world, &ctx.strategies);
+        let mut sampler = Sampler::new(index, self.pass, self.seed ^ LIGHT_SALT);
+        let (index, pick) = ctx.picker.pick(sampler.next_f32())?;
+        let light = &world.lights[index];
+        let (u1, u2) = (sampler.next_2d(), sampler.next_2d());
+        let emission = light.emit(ctx.bounds, u1, u2);
+        if !(emission.pdf > 0.0 && emission.power.is_finite()) || ctx.max_length == 0 {
+            return None;
+        }
+        Some(Flight {
+            sampler,
+            scope: PathScope::new(world, emission.ray.origin),
+            light,
+            pick,
+            emitted_at: (emission.point, emission.normal),
+            ray: emission.ray,
+            throughput: emission.power / pick,
+            partials: Partials::light(s, emission.pdf * pick, emission.cos, light.is_delta()),
+            length: 1,
+        })
     }
-    let mut throughput = emission.power / pick;
-    let mut partials = Partials::light(s, emission.pdf * pick, emission.cos, light.is_delta());
-    let scope = PathScope::new(world, emission.ray.origin);
-    let mut ray = emission.ray;
-    for length in 1..ctx.max_length + 1 {
-        out.counters.rays += 1;
-        let Some(hit) = scope.intersect(&ray) else { return };
-        let (wo, n) = (-ray.direction, hit.surface.normal);
+
+    /// The path's vertex at `hit`, the nearest along its ray: kept and
+    /// joined to the camera unless specular, then scattered. False once
+    /// the path ends.
+    fn bounce(&self, path: &mut Flight, hit: &Hit, out: &mut ChunkPaths) -> bool {
+        let ctx = self.ctx;
+        let (world, s) = (ctx.world, &ctx.strategies);
+        let (light, pick, length) = (path.light, path.pick, path.length);
+        let (wo, n) = (-path.ray.direction, hit.surface.normal);
         if length == 1 {
-            let direct = light.direct_pdf_a(hit.surface.point, emission.point, emission.normal);
-            partials.first_hit(s, direct * pick);
+            let direct = light.direct_pdf_a(hit.surface.point, path.emitted_at.0, path.emitted_at.1);
+            path.partials.first_hit(s, direct * pick);
         }
         let from_infinity = length == 1 && !light.is_finite();
         let distance2 = hit.surface.t * hit.surface.t;
-        partials.arrive(s, (!from_infinity).then_some(distance2), wo.dot(n));
-        let bsdf = Bsdf::new(world.material_of(&hit));
+        path.partials.arrive(s, (!from_infinity).then_some(distance2), wo.dot(n));
+        let bsdf = Bsdf::new(world.material_of(hit));
+        let sampler = &mut path.sampler;
         if !bsdf.is_specular() {
-            let vertex = LightVertex { hit: hit.surface, wo, bsdf, throughput, length, partials, held: scope.held };
+            let (throughput, partials, held) = (path.throughput, path.partials, path.scope.held);
+            let vertex = LightVertex { hit: hit.surface, wo, bsdf, throughput, length, partials, held };
             if ctx.keeps_vertices() {
                 out.vertices.push(vertex);
             }
             if s.connect || ctx.light_tracing {
-                join_camera(ctx, &scope, &vertex, sampler, out);
+                join_camera(ctx, &path.scope, &vertex, sampler, out);
             }
         }
         // A longer path would have no strategy left to finish it
         if length + 2 > ctx.max_length {
-            return;
+            return false;
         }
-        let Some(scattered) = bsdf.sample(wo, n, sampler, Transport::Importance) else { return };
+        let Some(scattered) = bsdf.sample(wo, n, sampler, Transport::Importance) else { return false };
         let go_on = bsdf.continuation();
         if sampler.next_f32() >= go_on {
-            return;
+            return false;
         }
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
         let reverse = if scattered.delta { scattered.pdf } else { bsdf.pdf(scattered.wi, wo, facing) };
-        partials.scatter(s, scattered.pdf * go_on, reverse * go_on, scattered.wi.dot(n), scattered.delta);
-        throughput *= scattered.weight / go_on;
-        if throughput == Rgb::ZERO {
-            return;
+        path.partials.scatter(s, scattered.pdf * go_on, reverse * go_on, scattered.wi.dot(n), scattered.delta);
+        path.throughput *= scattered.weight / go_on;
+        if path.throughput == Rgb::ZERO {
+            return false;
         }
-        ray = hit.surface.spawn_ray(scattered.wi);
+        path.ray = hit.surface.spawn_ray(scattered.wi);
+        path.length += 1;
+        path.length <= ctx.max_length
+    }
+
+    /// The paths `indices`, one at a time.
+    fn trace_one_by_one(&self, indices: Range<u64>) -> ChunkPaths {
+        let mut out = ChunkPaths::default();
+        for index in indices {
+            if let Some(mut path) = self.launch(index) {
+                loop {
+                    out.counters.rays += 1;
+                    let Some(hit) = path.scope.intersect(&path.ray) else { break };
+                    if !self.bounce(&mut path, &hit, &mut out) {
+                        break;
+                    }
+                }
+            }
+            out.ends.push(out.vertices.len() as u32);
+        }
+        out
+    }
+
+    /// The paths `indices`, eight at a time: their rays through the
+    /// paths' eight-lane hit loop, each vertex on its own; what they make
+    /// is put back in path order, as `trace_one_by_one` makes it.
+    fn trace_eight_at_a_time(&self, path_lanes: &PathLanes, indices: Range<u64>) -> ChunkPaths {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: the CPU has AVX2 (`trace` asked `runs_in_lanes`).
+        #[allow(unsafe_code)]
+        return unsafe { self.trace_avx2(path_lanes, indices) };
+        #[cfg(not(target_arch = "x86_64"))]
+        self.trace_lanes(path_lanes, indices)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn trace_avx2(&self, path_lanes: &PathLanes, indices: Range<u64>) -> ChunkPaths {
+        self.trace_lanes(path_lanes, indices)
+    }
+
+    #[inline(always)]
+    fn trace_lanes(&self, path_lanes: &PathLanes, indices: Range<u64>) -> ChunkPaths {
+        let mut out = ChunkPaths::default();
+        // Which path made each vertex, splat and contribution: its place in the chunk
+        let mut places: [Vec<u32>; 3] = Default::default();
+        let mut flights: [Option<(u32, Flight)>; LANES] = Default::default();
+        let mut next = indices.start;
+        loop {
+            for flight in flights.iter_mut().filter(|f| f.is_none()) {
+                while flight.is_none() && next < indices.end {
+                    *flight = self.launch(next).map(|f| ((next - indices.start) as u32, f));
+                    next += 1;
+                }
+            }
+            if flights.iter().all(Option::is_none) {
+                break;
+            }
+            let rays = lanes::each(|i| flights[i].as_ref().map(|(_, f)| (f.ray, f.scope.held)));
+            out.counters.rays += rays.iter().flatten().count() as u64;
+            let hits = path_lanes.intersect8(self.ctx.world, &rays);
+            for (slot, hit) in flights.iter_mut().zip(&hits) {
+                let Some((place, path)) = slot else { continue };
+                let goes_on = match hit {
+                    Some(hit) => self.bounce(path, hit, &mut out),
+                    None => false,
+                };
+                places[0].resize(out.vertices.len(), *place);
+                places[1].resize(out.splats.len(), *place);
+                places[2].resize(out.contributions.len(), *place);
+                if !goes_on {
+                    *slot = None;
+                }
+            }
+        }
+        let paths = (indices.end - indices.start) as usize;
+        (out.vertices, out.ends) = reorder::by_item(&out.vertices, &places[0], paths);
+        out.splats = reorder::by_item(&out.splats, &places[1], paths).0;
+        out.contributions = reorder::by_item(&out.contributions, &places[2], paths).0;
+        out
     }
 }
 
@@ -217,5 +348,80 @@ fn join_camera(ctx: &Context, scope: &PathScope, vertex: &LightVertex, sampler: 
         let pixel = film.pixel(seen.pixel.0, seen.pixel.1);
         let strategy = Strategy::Connect { length: vertex.length + 1, light_vertices: vertex.length + 1 };
         PixelTally { pixel, out: &mut out.contributions }.add(strategy, value, weight);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::integrators::bidir::mis::Strategies;
+    use crate::render::integrators::bidir::strategies::StrategyFilm;
+    use crate::render::integrators::photon_map::emit::LightPicker;
+    use crate::render::settings::MisHeuristic;
+    use crate::render::world::camera::CameraModel;
+    use crate::render::world::World;
+    use crate::scene::presets;
+
+    /// Every preset, and each way the light subpaths are used (light
+    /// tracing, connecting, merging, both; the strategy view open or not;
+    /// paths of two segments at most and of eight):
+    /// eight at a time, the paths make what they make one at a time — the
+    /// same vertices, ends, splats, contributions and counts, bit for bit.
+    #[test]
+    fn eight_at_a_time_make_what_one_at_a_time_make() {
+        assert!(PathLanes::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
+        let (width, height) = (48, 36);
+        let film = StrategyFilm::new(width, height);
+        for name in presets::names() {
+            let scene = presets::preset(name).and_then(Result::ok).expect("preset");
+            let camera = CameraModel::new(&scene.camera, width, height);
+            let (world, visible_radius) = World::for_view(&scene, &camera, width, height);
+            let path_lanes = PathLanes::new(&world).expect("a world the lanes trace");
+            let picker = LightPicker::new(&world);
+            let ways = [(false, false, true), (true, false, false), (false, true, false), (true, true, false)];
+            let mut made = 0;
+            // Paths cut short (at two segments: one vertex joined, none scattered) and not
+            for (max_length, (connect, merge, light_tracing)) in ways.iter().flat_map(|&w| [(2, w), (8, w)]) {
+                for strategy_film in [None, Some(&film)] {
+                    let pixels = (width * height) as f32;
+                    let ctx = Context {
+                        world: &world,
+                        camera: &camera,
+                        strategies: Strategies::new(MisHeuristic::Power, connect, merge, pixels, visible_radius * 0.01),
+                        picker: &picker,
+                        bounds: world.bounds(),
+                        background: world.lights.iter().position(|l| matches!(l, LightSource::Background { .. })),
+                        max_length,
+                        light_tracing,
+                        strategy_film,
+                    };
+                    let flights = Flights { ctx: &ctx, pass: 3, seed: 11 };
+                    // Not a multiple of eight, away from 0
+                    let indices = 100..1123;
+                    let one = flights.trace_one_by_one(indices.clone());
+                    let eight = flights.trace_eight_at_a_time(&path_lanes, indices);
+                    let view = strategy_film.is_some();
+                    let what = format!("{name}, connect {connect}, merge {merge}, view {view}, {max_length} segments");
+                    let vertex_bits = |paths: &ChunkPaths| format!("{:?}", paths.vertices);
+                    assert!(vertex_bits(&one) == vertex_bits(&eight), "{what}: the vertices differ");
+                    assert_eq!(one.ends, eight.ends, "{what}");
+                    let splat_bits = |paths: &ChunkPaths| {
+                        paths
+                            .splats
+                            .iter()
+                            .map(|s| (s.x, s.y, s.value.to_array().map(f32::to_bits)))
+                            .collect::<Vec<_>>()
+                    };
+                    assert!(splat_bits(&one) == splat_bits(&eight), "{what}: the splats differ");
+                    assert_eq!(format!("{:?}", one.contributions), format!("{:?}", eight.contributions), "{what}");
+                    assert_eq!(format!("{:?}", one.counters), format!("{:?}", eight.counters), "{what}");
+                    made += eight.vertices.len() + eight.splats.len();
+                    if strategy_film.is_some() && (connect || light_tracing) {
+                        assert!(!eight.contributions.is_empty() || eight.splats.is_empty(), "{what}: no contributions");
+                    }
+                }
+            }
+            assert!(made > 1000, "{name}: only {made} vertices and splats made");
+        }
     }
 }
