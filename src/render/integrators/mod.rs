@@ -5,6 +5,7 @@
 //! estimation (`next_event`), BSDFs, occlusion and the lanes (`world`).
 
 pub mod bidir;
+pub mod flying;
 pub mod next_event;
 pub mod path;
 pub mod path_lanes;

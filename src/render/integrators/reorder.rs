@@ -16,13 +16,14 @@ pub fn by_item<T: Copy>(records: &[T], places: &[u32], items: usize) -> (Vec<T>,
         first[i] += first[i - 1];
     }
     let ends = first[1..].to_vec();
-    let mut order = vec![0u32; records.len()];
-    for (i, &place) in places.iter().enumerate() {
+    let Some(&any) = records.first() else { return (Vec::new(), ends) };
+    let mut sorted = vec![any; records.len()];
+    for (record, &place) in records.iter().zip(places) {
         let at = &mut first[place as usize];
-        order[*at as usize] = i as u32;
+        sorted[*at as usize] = *record;
         *at += 1;
     }
-    (order.iter().map(|&i| records[i as usize]).collect(), ends)
+    (sorted, ends)
 }
 
 #[cfg(test)]

@@ -4,9 +4,9 @@
 //! and, where connecting is on, joined to the camera: a splat on the pixel
 //! it lands on. Path i's random stream is fixed by (i, pass, seed), and
 //! chunks are joined in order, so nothing depends on the thread count.
-//! Eight paths are traced at a time (their rays through the paths' hit
-//! loop, `PathLanes::intersect8`), and what they make is put back in path
-//! order, so nothing depends on how the lanes fell either.
+//! Eight paths are traced at a time (`flying`), and what they make is put
+//! back in path order (`reorder`), so nothing depends on how the lanes
+//! fell either.
 
 use std::ops::Range;
 
@@ -20,9 +20,8 @@ use crate::geometry::{Ray, SurfaceHit};
 use crate::render::film::Splat;
 use crate::render::integrators::next_event::PathScope;
 use crate::render::integrators::path_lanes::PathLanes;
-use crate::render::integrators::{reorder, Counters};
+use crate::render::integrators::{flying, reorder, Counters};
 use crate::render::world::bsdf::{Bsdf, Transport};
-use crate::render::world::lanes::{self, LANES};
 use crate::render::world::light::LightSource;
 use crate::render::world::rng::Sampler;
 use crate::render::world::Hit;
@@ -94,7 +93,7 @@ pub fn trace(
     seed: u64,
     keep_going: &(dyn Fn() -> bool + Sync),
 ) -> Option<LightPaths> {
-    let path_lanes = PathLanes::new(ctx.world).filter(|_| PathLanes::runs_in_lanes());
+    let path_lanes = PathLanes::new(ctx.world);
     let chunks = count.div_ceil(CHUNK) as usize;
     let per_chunk: Option<Vec<ChunkPaths>> = (0..chunks)
         .into_par_iter()
@@ -104,11 +103,7 @@ pub fn trace(
                 return None;
             }
             let indices = chunk as u64 * CHUNK..((chunk as u64 + 1) * CHUNK).min(count);
-            let flights = Flights { ctx, pass, seed };
-            Some(match &path_lanes {
-                Some(path_lanes) => flights.trace_eight_at_a_time(path_lanes, indices),
-                None => flights.trace_one_by_one(indices),
-            })
+            Some(Flights { ctx, pass, seed }.trace(path_lanes.as_ref(), indices))
         })
         .collect();
     let mut paths = LightPaths {
@@ -236,80 +231,31 @@ impl<'w> Flights<'_, 'w> {
         path.length <= ctx.max_length
     }
 
-    /// The paths `indices`, one at a time.
-    fn trace_one_by_one(&self, indices: Range<u64>) -> ChunkPaths {
+    /// The paths `indices`: what they make, in path order. Eight at a time
+    /// through `path_lanes` where given (and the CPU allows), the same bit
+    /// for bit.
+    fn trace(&self, path_lanes: Option<&PathLanes>, indices: Range<u64>) -> ChunkPaths {
         let mut out = ChunkPaths::default();
-        for index in indices {
-            if let Some(mut path) = self.launch(index) {
-                loop {
-                    out.counters.rays += 1;
-                    let Some(hit) = path.scope.intersect(&path.ray) else { break };
-                    if !self.bounce(&mut path, &hit, &mut out) {
-                        break;
-                    }
-                }
-            }
-            out.ends.push(out.vertices.len() as u32);
-        }
-        out
-    }
-
-    /// The paths `indices`, eight at a time: their rays through the
-    /// paths' eight-lane hit loop, each vertex on its own; what they make
-    /// is put back in path order, as `trace_one_by_one` makes it.
-    fn trace_eight_at_a_time(&self, path_lanes: &PathLanes, indices: Range<u64>) -> ChunkPaths {
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: the CPU has AVX2 (`trace` asked `runs_in_lanes`).
-        #[allow(unsafe_code)]
-        return unsafe { self.trace_avx2(path_lanes, indices) };
-        #[cfg(not(target_arch = "x86_64"))]
-        self.trace_lanes(path_lanes, indices)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn trace_avx2(&self, path_lanes: &PathLanes, indices: Range<u64>) -> ChunkPaths {
-        self.trace_lanes(path_lanes, indices)
-    }
-
-    #[inline(always)]
-    fn trace_lanes(&self, path_lanes: &PathLanes, indices: Range<u64>) -> ChunkPaths {
-        let mut out = ChunkPaths::default();
-        // Which path made each vertex, splat and contribution: its place in the chunk
+        // Which path made each vertex, splat and contribution: its place among `indices`
         let mut places: [Vec<u32>; 3] = Default::default();
-        let mut flights: [Option<(u32, Flight)>; LANES] = Default::default();
-        let mut next = indices.start;
-        loop {
-            for flight in flights.iter_mut().filter(|f| f.is_none()) {
-                while flight.is_none() && next < indices.end {
-                    *flight = self.launch(next).map(|f| ((next - indices.start) as u32, f));
-                    next += 1;
-                }
-            }
-            if flights.iter().all(Option::is_none) {
-                break;
-            }
-            let rays = lanes::each(|i| flights[i].as_ref().map(|(_, f)| (f.ray, f.scope.held)));
-            out.counters.rays += rays.iter().flatten().count() as u64;
-            let hits = path_lanes.intersect8(self.ctx.world, &rays);
-            for (slot, hit) in flights.iter_mut().zip(&hits) {
-                let Some((place, path)) = slot else { continue };
-                let goes_on = match hit {
-                    Some(hit) => self.bounce(path, hit, &mut out),
-                    None => false,
-                };
-                places[0].resize(out.vertices.len(), *place);
-                places[1].resize(out.splats.len(), *place);
-                places[2].resize(out.contributions.len(), *place);
-                if !goes_on {
-                    *slot = None;
-                }
-            }
-        }
-        let paths = (indices.end - indices.start) as usize;
-        (out.vertices, out.ends) = reorder::by_item(&out.vertices, &places[0], paths);
-        out.splats = reorder::by_item(&out.splats, &places[1], paths).0;
-        out.contributions = reorder::by_item(&out.contributions, &places[2], paths).0;
+        let mut rays = 0;
+        let ray = |path: &Flight| {
+            rays += 1;
+            (path.ray, path.scope.held)
+        };
+        let bounce = |place, path: &mut Flight, hit: &Hit| {
+            let goes_on = self.bounce(path, hit, &mut out);
+            places[0].resize(out.vertices.len(), place);
+            places[1].resize(out.splats.len(), place);
+            places[2].resize(out.contributions.len(), place);
+            goes_on
+        };
+        let count = (indices.end - indices.start) as usize;
+        flying::fly(path_lanes, self.ctx.world, indices, |index| self.launch(index), ray, bounce);
+        out.counters.rays += rays;
+        (out.vertices, out.ends) = reorder::by_item(&out.vertices, &places[0], count);
+        out.splats = reorder::by_item(&out.splats, &places[1], count).0;
+        out.contributions = reorder::by_item(&out.contributions, &places[2], count).0;
         out
     }
 }
@@ -398,8 +344,8 @@ mod tests {
                     let flights = Flights { ctx: &ctx, pass: 3, seed: 11 };
                     // Not a multiple of eight, away from 0
                     let indices = 100..1123;
-                    let one = flights.trace_one_by_one(indices.clone());
-                    let eight = flights.trace_eight_at_a_time(&path_lanes, indices);
+                    let one = flights.trace(None, indices.clone());
+                    let eight = flights.trace(Some(&path_lanes), indices);
                     let view = strategy_film.is_some();
                     let what = format!("{name}, connect {connect}, merge {merge}, view {view}, {max_length} segments");
                     let vertex_bits = |paths: &ChunkPaths| format!("{:?}", paths.vertices);

@@ -1,11 +1,8 @@
 //! One photon's flight: it leaves a light (`Tracing::launch`), and at each
 //! hit is stored if its map keeps it and scattered by the surface, with
 //! Russian roulette at diffuse surfaces (`Tracing::bounce`). Photon i's
-//! random stream is fixed by (i, pass, seed). The tracers one photon at a
-//! time (`Tracing::trace_one_by_one`) and eight at a time (`trace_lanes`)
-//! both fly photons by these two.
-
-use std::ops::Range;
+//! random stream is fixed by (i, pass, seed). `trace` flies photons by
+//! these two, eight at a time or one (`flying`).
 
 use glam::Vec3;
 
@@ -144,19 +141,5 @@ impl<'a> Tracing<'a> {
         flight.ray = hit.surface.spawn_ray(scattered.wi);
         flight.depth += 1;
         flight.depth < self.max_depth
-    }
-
-    /// The photons `indices`, one at a time: what they store, in order.
-    pub(super) fn trace_one_by_one(&self, indices: Range<u64>) -> Vec<Photon> {
-        let mut stored = Vec::new();
-        for index in indices {
-            let Some(mut flight) = self.launch(index) else { continue };
-            while let Some(hit) = self.world.intersect_held(&flight.ray, f32::INFINITY, flight.held) {
-                if !self.bounce(&mut flight, &hit, &mut |photon| stored.push(photon)) {
-                    break;
-                }
-            }
-        }
-        stored
     }
 }

@@ -8,7 +8,6 @@ pub mod kdtree;
 pub mod maps;
 pub mod record;
 pub mod trace;
-mod trace_lanes;
 
 pub use kdtree::{Neighbours, PhotonKdTree};
 pub use maps::{PhotonMapStats, PhotonMaps, QueryStats};

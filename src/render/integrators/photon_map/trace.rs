@@ -3,16 +3,19 @@
 //! hits according to which map they are for. Photon i's random stream is
 //! fixed by (i, pass, seed), and chunks are joined in order, so the maps do
 //! not depend on the thread count. Eight photons are traced at a time
-//! where the CPU and the world allow (`trace_lanes`), with the same bits.
+//! where the CPU and the world allow (`flying`), then put back in photon
+//! order (`reorder`): the same maps, bit for bit.
+
+use std::ops::Range;
 
 use rayon::prelude::*;
 
 pub use super::flight::MapKind;
-use super::flight::Tracing;
+use super::flight::{Flight, Tracing};
 use super::record::Photon;
-use super::trace_lanes;
 use crate::render::integrators::path_lanes::PathLanes;
-use crate::render::world::World;
+use crate::render::integrators::{flying, reorder};
+use crate::render::world::{Hit, World};
 
 /// Photons a task traces: the unit of work a cancel waits for at most.
 pub const CHUNK: u64 = 4096;
@@ -37,8 +40,8 @@ pub fn trace_photons_until(
     let Some(tracing) = Tracing::new(world, kind, count, pass, seed, max_depth) else {
         return Some(Vec::new());
     };
-    // Built once for all the chunks: None where the CPU or the world has no lanes
-    let lanes = PathLanes::new(world).filter(|_| PathLanes::runs_in_lanes());
+    // Built once for all the chunks: None where the world has no lanes
+    let lanes = PathLanes::new(world);
     // usize: rayon splits only ranges of usize by index
     let chunks = count.div_ceil(CHUNK) as usize;
     let per_chunk: Option<Vec<Vec<Photon>>> = (0..chunks)
@@ -50,11 +53,111 @@ pub fn trace_photons_until(
             }
             let chunk = chunk as u64;
             let indices = chunk * CHUNK..((chunk + 1) * CHUNK).min(count);
-            Some(match &lanes {
-                Some(lanes) => trace_lanes::trace_chunk(lanes, &tracing, indices),
-                None => tracing.trace_one_by_one(indices),
-            })
+            Some(trace_chunk(lanes.as_ref(), &tracing, indices))
         })
         .collect();
     Some(per_chunk?.concat())
+}
+
+/// The photons `indices`: what they store, in photon order. Eight at a
+/// time through `path_lanes` where given (and the CPU allows), with the
+/// same records bit for bit.
+fn trace_chunk(path_lanes: Option<&PathLanes>, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
+    // Each stored photon, and its photon's place among `indices`
+    let (mut stored, mut places) = (Vec::new(), Vec::new());
+    let bounce = |place, flight: &mut Flight, hit: &Hit| {
+        tracing.bounce(flight, hit, &mut |photon| {
+            stored.push(photon);
+            places.push(place);
+        })
+    };
+    let ray = |flight: &Flight| (flight.ray, flight.held);
+    let items = (indices.end - indices.start) as usize;
+    flying::fly(path_lanes, tracing.world(), indices, |index| tracing.launch(index), ray, bounce);
+    reorder::by_item(&stored, &places, items).0
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::render::world::camera::CameraModel;
+    use crate::render::world::World;
+    use crate::scene::{presets, Attenuation, Light, LightKind, Rgb, Scene, ValidScene};
+
+    fn preset(name: &str) -> Scene {
+        presets::preset(name).and_then(Result::ok).expect("preset").into_scene()
+    }
+
+    /// Each map's photons of `scene`, eight at a time and one at a time:
+    /// the same records, bit for bit, in the same order. Returns how many
+    /// were stored.
+    fn assert_lanes_store_what_one_by_one_does(name: &str, scene: Scene, max_depth: u32) -> usize {
+        let scene = ValidScene::new(scene).expect("a valid scene");
+        // As a render builds it: walls anchored where the camera looks
+        let camera = CameraModel::new(&scene.camera, 64, 48);
+        let (world, _) = World::for_view(&scene, &camera, 64, 48);
+        let lanes = PathLanes::new(&world).expect("a world the lanes trace");
+        let mut stored = 0;
+        for kind in [MapKind::Global, MapKind::Caustic, MapKind::Indirect, MapKind::All] {
+            for pass in 0..2 {
+                let Some(tracing) = Tracing::new(&world, kind, 20_000, pass, 20_261_201, max_depth) else { continue };
+                // Away from 0 and not a multiple of eight
+                let indices = 1000..5099;
+                let one_by_one = trace_chunk(None, &tracing, indices.clone());
+                let eight = trace_chunk(Some(&lanes), &tracing, indices);
+                let bytes = |photons: &[Photon]| photons.iter().map(Photon::to_bytes).collect::<Vec<_>>();
+                let same = bytes(&one_by_one) == bytes(&eight);
+                assert!(same, "{name}, {kind:?}, pass {pass}, depth {max_depth}: the maps differ");
+                stored += eight.len();
+            }
+        }
+        stored
+    }
+
+    #[test]
+    fn every_preset_stores_what_one_photon_at_a_time_stores() {
+        assert!(PathLanes::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
+        for name in presets::names() {
+            let stored = assert_lanes_store_what_one_by_one_does(name, preset(name), 16);
+            assert!(stored > 1000, "{name}: only {stored} photons stored");
+        }
+    }
+
+    /// Photons that end at the depth cap, or before any bounce.
+    #[test]
+    fn short_flights_end_at_the_depth_cap() {
+        for depth in [0, 1, 2, 3] {
+            let stored = assert_lanes_store_what_one_by_one_does("caustics", preset("caustics"), depth);
+            assert_eq!(stored == 0, depth == 0, "depth {depth}: {stored} photons stored");
+        }
+    }
+
+    /// Lights outside the walls (photons that start outside and enter the
+    /// room from either side of a wall), a directional light and the sky,
+    /// whose photons start outside the scene.
+    #[test]
+    fn photons_from_outside_the_walls_store_the_same() {
+        let light = |name: &str, kind: LightKind, intensity: f32| Light {
+            name: name.into(),
+            kind,
+            color: Rgb::ONE,
+            intensity,
+            attenuation: Attenuation::default(),
+            enabled: true,
+        };
+        for name in ["cornell", "smallpt"] {
+            let mut scene = preset(name);
+            let outside = scene.camera.position + Vec3::new(0.0, 0.0, 5.0) * scene.camera.position.length().max(1.0);
+            scene.lights.push(light("outside", LightKind::Point { position: outside }, 1e4));
+            scene.lights.push(light("sun", LightKind::Directional { direction: Vec3::new(0.2, -1.0, -0.3) }, 1.0));
+            scene.background = Rgb::new(0.2, 0.3, 0.4);
+            let world = World::new(&ValidScene::new(scene.clone()).expect("a valid scene"));
+            assert!(!world.holds(outside), "{name}: the light is outside the walls");
+            let stored = assert_lanes_store_what_one_by_one_does(name, scene, 16);
+            // Smallpt's walls are spheres: what comes from outside stays outside
+            assert!(stored > 200, "{name}: only {stored} photons stored");
+        }
+    }
 }
