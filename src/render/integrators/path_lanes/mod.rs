@@ -250,7 +250,8 @@ impl PathLanes {
     /// The nearest hits of up to eight rays, each `held` or not as
     /// `World::intersect_held` takes it: that function's hits, bit for bit,
     /// from the paths' hit loop, for callers that go on lane by lane
-    /// (photon tracing). Fast only inlined into code built for AVX2.
+    /// (photons and light subpaths, `flying`). Fast only inlined into code
+    /// built for AVX2.
     #[inline(always)]
     pub(crate) fn intersect8(&self, world: &World, rays: &[Option<(Ray, bool)>; LANES]) -> [Option<Hit>; LANES] {
         let active = M8::from_fn(|i| rays[i].is_some());
@@ -520,10 +521,9 @@ impl PathLanes {
     /// wall): `World::intersect_held`, eight rays at a time, bit for bit.
     #[inline(always)]
     fn nearest(&self, active: M8, held: M8, origin: V8, direction: V8) -> LaneHits {
-        // Nearest sphere, in index order: ties keep the first, as
-        // `SphereLanes::nearest`; paths inside the walls meet them only on
-        // their way out, as `World::intersect_held`
-        // Usually every path is inside the walls: then their near roots are never asked
+        // Spheres in index order, ties keeping the first (`SphereLanes::nearest`):
+        // all of them for paths not held, all but the walls for held ones.
+        // Usually every path is held: then the walls' near roots are never asked
         let every_held = !active.and_not(held).any();
         let mut t_hit = F8::splat(f32::INFINITY);
         // The index in a float lane, counted there too: one blend per sphere

@@ -49,8 +49,8 @@ pub(super) struct Tracing<'a> {
 
 /// One photon between its bounces.
 pub(super) struct Flight {
-    pub ray: Ray,
-    pub held: bool,
+    pub(super) ray: Ray,
+    pub(super) held: bool,
     power: Rgb,
     depth: u32,
     diffuse_bounces: u32,
