@@ -149,7 +149,7 @@ fn photon_statistics_are_printed() {
     assert_eq!(number_before(&sppm, "photons"), 5000.0, "{sppm}");
     // Every stage of the pass was clocked (each does work, so none is 0)
     let split = sppm.lines().find(|l| l.starts_with("SPPM last pass: ")).expect("the time split");
-    for stage in ["eye pass", "photon tracing", "kd-tree", "gather"] {
+    for stage in ["eye pass", "photon tracing", "photon grid", "gather"] {
         let after = split.split(&format!("{stage} ")).nth(1).unwrap_or_else(|| panic!("no {stage} in {split}"));
         let ms: f64 = after.split_whitespace().next().and_then(|w| w.parse().ok()).expect("a number of ms");
         assert!(ms > 0.0 && after.split_whitespace().nth(1).is_some_and(|w| w.starts_with("ms")), "{split}");

@@ -463,7 +463,7 @@ fn the_photon_plots_split_an_sppm_pass_into_its_stages() {
     let node = harness.get_by_label_contains("1: SPPM last pass: ");
     let node = egui_kittest::kittest::NodeT::accesskit_node(&node);
     let label = node.label().or_else(|| node.value()).unwrap_or_default();
-    for stage in ["eye pass", "photon tracing", "kd-tree", "gather"] {
+    for stage in ["eye pass", "photon tracing", "photon grid", "gather"] {
         let after = label.split(&format!("{stage} ")).nth(1).unwrap_or_else(|| panic!("no {stage} in {label}"));
         let ms: Option<f64> = after.split_whitespace().next().and_then(|w| w.parse().ok());
         assert!(ms.is_some_and(f64::is_finite) && after.contains(" ms"), "{label}");

@@ -75,7 +75,7 @@ pub struct SppmTimes {
     pub eye: Duration,
     /// Emitting and tracing the pass's photons.
     pub trace: Duration,
-    /// The kd-tree over the stored photons.
+    /// The hash grid over the stored photons (`photon_map::grid`).
     pub build: Duration,
     /// Every visible point's photons gathered, its radius and flux updated.
     pub gather: Duration,
@@ -84,7 +84,7 @@ pub struct SppmTimes {
 impl SppmTimes {
     /// The stages, named, in the order a pass runs them.
     pub fn stages(&self) -> [(&'static str, Duration); 4] {
-        [("eye pass", self.eye), ("photon tracing", self.trace), ("kd-tree", self.build), ("gather", self.gather)]
+        [("eye pass", self.eye), ("photon tracing", self.trace), ("photon grid", self.build), ("gather", self.gather)]
     }
 
     /// "eye pass 95 ms, photon tracing 364 ms, …": three decimals for a

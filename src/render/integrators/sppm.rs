@@ -13,7 +13,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::next_event::PathScope;
-use super::photon_map::kdtree::PhotonKdTree;
+use super::photon_map::grid::PhotonGrid;
 use super::photon_map::trace::{trace_photons_until, MapKind};
 use super::specular::{follow_specular, Emission, Landing};
 use super::{Counters, PassObserver, PassReport, SppmTimes, Stage};
@@ -115,7 +115,11 @@ impl Sppm {
         report.photon.photons_traced = count;
         report.photon.photons_stored = photons.len() as u64;
         let build_start = Instant::now();
-        let tree = PhotonKdTree::build(photons);
+        // Cells as wide as the widest radius: no query touches more than 3×3×3
+        let widest = (self.pixels.iter().flatten())
+            .filter(|p| p.visible.is_some())
+            .fold(0.0f32, |widest, p| widest.max(p.radius));
+        let grid = PhotonGrid::build(&photons, widest);
         times.build = build_start.elapsed();
         if !observer.is_current() {
             return None;
@@ -131,7 +135,7 @@ impl Sppm {
                 }
                 let mut sum = 0.0;
                 for pixel in pixels.iter_mut() {
-                    pixel.gather(&tree, alpha);
+                    pixel.gather(&grid, alpha);
                     sum += pixel.radius as f64;
                 }
                 tile.samples += 1;
@@ -190,21 +194,25 @@ impl SppmPixel {
 
     /// Gather this pass's photons at the visible point and update the
     /// radius, count and flux.
-    pub fn gather(&mut self, tree: &PhotonKdTree, alpha: f32) {
+    pub fn gather(&mut self, grid: &PhotonGrid, alpha: f32) {
         let Some(vp) = self.visible.take() else {
             return;
         };
-        let mut flux = Rgb::ZERO;
-        let mut found = 0u32;
-        let constant = vp.bsdf.front_constant(vp.wo, vp.facing);
-        tree.for_each_within(vp.point, self.radius, |photon| {
-            let incoming = photon.incoming_direction();
-            if incoming.dot(vp.facing) < 0.0 {
-                let f = constant.unwrap_or_else(|| vp.bsdf.eval(vp.wo, -incoming, vp.facing));
-                flux += f * Vec3::from_array(photon.power);
-                found += 1;
+        // A constant BSDF multiplies the photons' summed power; any other is
+        // evaluated photon by photon
+        let (flux, found) = match vp.bsdf.front_constant(vp.wo, vp.facing) {
+            Some(f) => {
+                let found = grid.gather_front(vp.point, self.radius, vp.facing, |_| {});
+                (f * found.power, found.count)
             }
-        });
+            None => {
+                let mut flux = Rgb::ZERO;
+                let found = grid.gather_front(vp.point, self.radius, vp.facing, |i| {
+                    flux += vp.bsdf.eval(vp.wo, -grid.incoming(i), vp.facing) * grid.power(i);
+                });
+                (flux, found.count)
+            }
+        };
         if found == 0 {
             return;
         }
@@ -249,7 +257,7 @@ mod tests {
     fn radius_shrinks_stays_positive_and_finite_over_thousands_of_passes() {
         let photons: Vec<Photon> =
             (0..50).map(|i| Photon::new(Vec3::new(i as f32 * 1e-3, 0.0, 0.0), -Vec3::Y, [1.0; 3])).collect();
-        let tree = PhotonKdTree::build(photons);
+        let grid = PhotonGrid::build(&photons, 0.1);
         let mut pixel = SppmPixel { radius: 0.1, ..Default::default() };
         let mut last = pixel.radius;
         for pass in 1..=5000u32 {
@@ -260,7 +268,7 @@ mod tests {
                 bsdf: Bsdf::Lambert { albedo: Vec3::splat(0.5) },
                 throughput: Rgb::ONE,
             });
-            pixel.gather(&tree, 2.0 / 3.0);
+            pixel.gather(&grid, 2.0 / 3.0);
             assert!(pixel.radius > 0.0 && pixel.radius.is_finite() && pixel.radius <= last);
             assert!(pixel.value(pass).is_finite());
             last = pixel.radius;

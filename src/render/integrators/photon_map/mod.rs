@@ -4,6 +4,7 @@
 pub mod emit;
 pub mod file;
 mod flight;
+pub mod grid;
 pub mod kdtree;
 pub mod maps;
 pub mod record;

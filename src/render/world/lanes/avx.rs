@@ -47,6 +47,12 @@ impl F8 {
         F8(unsafe { _mm256_setr_ps(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]) })
     }
 
+    /// Eight consecutive values in memory, in one load.
+    #[inline(always)]
+    pub fn load(v: &[f32; LANES]) -> Self {
+        F8(unsafe { _mm256_loadu_ps(v.as_ptr()) })
+    }
+
     #[inline(always)]
     pub fn to_array(self) -> [f32; LANES] {
         let mut out = [0.0; LANES];

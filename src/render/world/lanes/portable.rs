@@ -33,6 +33,11 @@ impl F8 {
     }
 
     #[inline(always)]
+    pub fn load(v: &[f32; LANES]) -> Self {
+        F8(*v)
+    }
+
+    #[inline(always)]
     pub fn to_array(self) -> [f32; LANES] {
         self.0
     }
