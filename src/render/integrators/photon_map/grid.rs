@@ -174,8 +174,8 @@ impl PhotonGrid {
     fn cell_of(&self, p: Vec3) -> [i32; 3] {
         // Saturating casts: a point far outside lands in an edge cell, on
         // either side of the query as on the photons'
-        let c = ((p - self.origin) * self.inverse_cell).floor();
-        [c.x as i32, c.y as i32, c.z as i32]
+        let c = (p - self.origin) * self.inverse_cell;
+        [floor(c.x), floor(c.y), floor(c.z)]
     }
 
     fn bucket(&self, cell: [i32; 3]) -> u32 {
@@ -319,6 +319,13 @@ struct Query {
     point: Vec3,
     bound: f32,
     facing: Vec3,
+}
+
+/// ⌊x⌋, saturating: `f32::floor` is a libm call on x86-64 without SSE4.1.
+#[inline(always)]
+fn floor(x: f32) -> i32 {
+    let t = x as i32;
+    t.saturating_sub(((t as f32) > x) as i32)
 }
 
 #[inline(always)]
@@ -484,7 +491,12 @@ mod tests {
         for radius in [f32::NAN, -0.1] {
             assert_eq!(grid.gather_front(Vec3::splat(0.5), radius, Vec3::Y, |_| panic!()), FrontSum::default());
         }
-        let far = grid.gather_front(Vec3::splat(1e30), f32::MAX, Vec3::Y, |_| {});
-        assert_eq!(far.count as usize, brute_force(&photons, Vec3::splat(1e30), f32::MAX, Vec3::Y).len());
+        // Cells beyond i32 on either side (saturated), radii beyond any cell
+        for far in [Vec3::splat(1e30), Vec3::new(-1e30, 0.5, -3e9)] {
+            for radius in [0.3, 1e30, f32::MAX] {
+                let found = grid.gather_front(far, radius, Vec3::Y, |_| {});
+                assert_eq!(found.count as usize, brute_force(&photons, far, radius, Vec3::Y).len());
+            }
+        }
     }
 }
