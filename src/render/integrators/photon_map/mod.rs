@@ -1,6 +1,7 @@
 //! The photon map: photons traced from the lights into Jensen's global and
 //! caustic maps on our own kd-tree, their radiance estimate, and map files.
 
+pub mod cells;
 pub mod emit;
 pub mod file;
 mod flight;
