@@ -1,7 +1,9 @@
-//! The kd-tree against a brute-force scan on random point sets, including the
-//! awkward ones: duplicates, all points equal, k > n, n = 0 and 1, a radius
-//! that excludes everything, and the normal filter.
+//! The kd-tree's k nearest, and the hash grid's points within a radius,
+//! against a brute-force scan on random point sets, including the awkward
+//! ones: duplicates, all points equal, k > n, n = 0 and 1, a radius that
+//! excludes everything, points exactly on the radius, and the normal filter.
 
+use gi_studio::render::integrators::photon_map::cells::PointGrid;
 use gi_studio::render::integrators::photon_map::{Neighbours, Photon, PhotonKdTree};
 use glam::Vec3;
 use proptest::prelude::*;
@@ -45,6 +47,21 @@ fn tree_result(tree: &PhotonKdTree, q: Vec3, normal: Option<Vec3>, k: usize, max
     d
 }
 
+/// Sorted squared distances of the grid's points within `radius`, in cells
+/// `cell` wide; each point at most once.
+fn grid_result(photons: &[Photon], cell: f32, q: Vec3, radius: f32) -> Vec<f32> {
+    let grid = PointGrid::build(photons.len(), |i| photons[i].position, cell);
+    let mut indices = Vec::new();
+    grid.for_each_within(q, radius, |i| indices.push(i));
+    let mut unique = indices.clone();
+    unique.sort_unstable();
+    unique.dedup();
+    assert_eq!(unique.len(), indices.len(), "a point found twice");
+    let mut d: Vec<f32> = indices.iter().map(|&i| (photons[i as usize].position - q).length_squared()).collect();
+    d.sort_by(f32::total_cmp);
+    d
+}
+
 fn coordinate() -> impl Strategy<Value = f32> {
     // A coarse grid makes duplicates and ties common
     prop_oneof![(-8i32..8).prop_map(|v| v as f32 * 0.25), -2.0f32..2.0]
@@ -73,14 +90,15 @@ proptest! {
     }
 
     #[test]
-    fn within_radius_equals_brute_force(points in points(), q in (coordinate(), coordinate(), coordinate()), radius in 0.0f32..2.0) {
+    fn grid_within_radius_equals_brute_force(
+        points in points(),
+        q in (coordinate(), coordinate(), coordinate()),
+        radius in 0.0f32..2.0,
+        cells in prop_oneof![Just(1.0f32), Just(4.0), 0.1f32..8.0],
+    ) {
         let photons: Vec<Photon> = points.iter().map(|(p, up)| photon(*p, *up)).collect();
-        let tree = PhotonKdTree::build(photons.clone());
         let q = Vec3::new(q.0, q.1, q.2);
-        let mut found = Vec::new();
-        tree.for_each_within(q, radius, |p| found.push((p.position - q).length_squared()));
-        found.sort_by(f32::total_cmp);
-        prop_assert_eq!(found, brute_force(&photons, q, None, usize::MAX, radius));
+        prop_assert_eq!(grid_result(&photons, radius * cells, q, radius), brute_force(&photons, q, None, usize::MAX, radius));
     }
 }
 
@@ -106,12 +124,12 @@ fn degenerate_sets() {
     assert!(tree_result(&tree, Vec3::splat(5.0), None, 50, 1.0).is_empty());
     // A negative radius holds nothing, not what its square would
     assert!(tree_result(&tree, Vec3::splat(0.5), None, 50, -1.0).is_empty());
-    let mut found = 0;
-    tree.for_each_within(Vec3::splat(0.5), -1.0, |_| found += 1);
-    assert_eq!(found, 0);
+    let same: Vec<Photon> = (0..1000).map(|_| photon((0.5, 0.5, 0.5), false)).collect();
+    assert!(grid_result(&same, 1.0, Vec3::splat(0.5), -1.0).is_empty());
     // A radius of 0 holds the photons exactly there (distance ≤ radius)
-    tree.for_each_within(Vec3::splat(0.5), 0.0, |_| found += 1);
-    assert_eq!(found, 1000);
+    assert_eq!(grid_result(&same, 1.0, Vec3::splat(0.5), 0.0), vec![0.0; 1000]);
+    assert_eq!(grid_result(&same, 0.0, Vec3::splat(0.5), 0.0), vec![0.0; 1000]);
+    assert!(grid_result(&[], 1.0, q, 1.0).is_empty());
     assert_eq!(tree_result(&tree, Vec3::splat(0.5), None, 50, 0.0), vec![0.0; 50]);
     // Photons from behind the surface are skipped: all travel down (-y), so a
     // surface facing down sees none of them
@@ -121,8 +139,9 @@ fn degenerate_sets() {
 
 /// Photons on a whole grid, gathered at every grid point with radii that are
 /// grid distances: neighbours lie exactly on the bound, and many of them on
-/// a split plane, in a subtree deferred at exactly the bound's distance. A
-/// photon on the bound is in (≤), as in the brute-force scan.
+/// a split plane, in a subtree deferred at exactly the bound's distance, and
+/// on the edges of the grid's cells. A photon on the bound is in (≤), as in
+/// the brute-force scan.
 #[test]
 fn photons_exactly_at_the_gather_radius_are_found() {
     let grid = |n: i32| (0..n).flat_map(move |x| (0..n).flat_map(move |y| (0..n).map(move |z| (x, y, z))));
@@ -137,9 +156,11 @@ fn photons_exactly_at_the_gather_radius_are_found() {
                 brute_force(&photons, q, None, 60, radius),
                 "at {q}, r {radius}"
             );
-            let mut found = 0;
-            tree.for_each_within(q, radius, |_| found += 1);
-            assert_eq!(found, brute_force(&photons, q, None, usize::MAX, radius).len(), "at {q}, r {radius}");
+            // Cells exactly the radius (SPPM's) and four radii (VCM's)
+            for cells in [1.0, 4.0] {
+                let within = brute_force(&photons, q, None, usize::MAX, radius);
+                assert_eq!(grid_result(&photons, radius * cells, q, radius), within, "at {q}, r {radius}");
+            }
         }
     }
 }

@@ -13,7 +13,7 @@ use super::strategies::{Strategy, Tally};
 use super::Context;
 use crate::geometry::Ray;
 use crate::render::integrators::next_event::PathScope;
-use crate::render::integrators::photon_map::kdtree::{KdPoint, KdTree};
+use crate::render::integrators::photon_map::cells::PointGrid;
 use crate::render::integrators::Counters;
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::light::{LightSample, LightSource};
@@ -22,43 +22,11 @@ use crate::render::world::sampling::uniform_sphere_pdf;
 use crate::render::world::Hit;
 use crate::scene::Rgb;
 
-/// A light vertex in the merge tree: where it is, and which it is.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct MergePoint {
-    position: Vec3,
-    index: u32,
-    axis: u8,
-}
-
-impl MergePoint {
-    pub fn of(vertices: &[LightVertex]) -> Vec<MergePoint> {
-        let point = |(i, v): (usize, &LightVertex)| MergePoint { position: v.hit.point, index: i as u32, axis: 0 };
-        vertices.iter().enumerate().map(point).collect()
-    }
-}
-
-impl KdPoint for MergePoint {
-    #[inline]
-    fn position(&self) -> Vec3 {
-        self.position
-    }
-
-    #[inline]
-    fn axis(&self) -> usize {
-        self.axis as usize
-    }
-
-    #[inline]
-    fn set_axis(&mut self, axis: usize) {
-        self.axis = axis as u8;
-    }
-}
-
 /// What the camera subpaths of a pass meet: the light subpaths and, for
-/// merging, their vertices in a tree.
+/// merging, their vertices in a grid.
 pub struct LightSide<'a> {
     pub paths: &'a LightPaths,
-    pub tree: Option<&'a KdTree<MergePoint>>,
+    pub grid: Option<&'a PointGrid>,
     pub radius: f32,
 }
 
@@ -302,13 +270,13 @@ fn merge<T: Tally>(
     counters: &mut Counters,
     tally: &mut T,
 ) -> Rgb {
-    let Some(tree) = light.tree else { return Rgb::ZERO };
+    let Some(grid) = light.grid else { return Rgb::ZERO };
     let normalization = ctx.strategies.vm_normalization;
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
     let go_on = bsdf.continuation();
     let mut sum = Rgb::ZERO;
-    tree.for_each_within(vertex.hit.surface.point, light.radius, |point| {
-        let light_vertex = &light.paths.vertices[point.index as usize];
+    grid.for_each_within(vertex.hit.surface.point, light.radius, |index| {
+        let light_vertex = &light.paths.vertices[index as usize];
         if light_vertex.length + vertex.length > ctx.max_length {
             return;
         }

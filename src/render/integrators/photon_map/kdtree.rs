@@ -227,39 +227,6 @@ impl<P: KdPoint> KdTree<P> {
     pub fn bytes(&self) -> usize {
         std::mem::size_of_val(self.photons.as_slice())
     }
-
-    /// Every photon with squared distance ≤ radius² (progressive photon
-    /// mapping, vertex merging).
-    pub fn for_each_within(&self, position: Vec3, radius: f32, mut f: impl FnMut(&P)) {
-        let n = self.photons.len();
-        if n == 0 || radius.is_nan() || radius < 0.0 {
-            return;
-        }
-        let bound = radius * radius;
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let mut node = stack[top] as usize;
-            loop {
-                let photon = &self.photons[node];
-                let offset = position - photon.position();
-                if offset.length_squared() <= bound {
-                    f(photon);
-                }
-                let delta = offset[photon.axis()];
-                let (near, far) = if delta < 0.0 { (2 * node + 1, 2 * node + 2) } else { (2 * node + 2, 2 * node + 1) };
-                if far < n && delta * delta <= bound {
-                    stack[top] = far as u32;
-                    top += 1;
-                }
-                if near >= n {
-                    break;
-                }
-                node = near;
-            }
-        }
-    }
 }
 
 impl PhotonKdTree {
