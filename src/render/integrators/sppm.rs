@@ -115,7 +115,7 @@ impl Sppm {
         report.photon.photons_traced = count;
         report.photon.photons_stored = photons.len() as u64;
         let build_start = Instant::now();
-        // Cells as wide as the widest radius: no query touches more than 3×3×3
+        // Cells as wide as the widest radius: a query touches 3×3×3 of them
         let widest = (self.pixels.iter().flatten())
             .filter(|p| p.visible.is_some())
             .fold(0.0f32, |widest, p| widest.max(p.radius));

@@ -86,7 +86,7 @@ impl PointGrid {
     }
 
     /// The index of every point with squared distance ≤ radius² from
-    /// `point` (as the kd-tree's `for_each_within` takes them), in an order
+    /// `point` (a point exactly on the radius is in), in an order
     /// fixed by the points and the query alone.
     pub fn for_each_within(&self, point: Vec3, radius: f32, mut f: impl FnMut(u32)) {
         let Some(touched) = self.touched(point, radius) else { return };

@@ -2,7 +2,8 @@
 //! front, from a hash grid of the pass's photons (`cells::PointGrid`) with
 //! their incoming directions and powers in columns beside the positions,
 //! scanned eight at a time. Cells are as wide as the widest radius, so a
-//! query touches at most 3×3×3 of them.
+//! query touches 3×3×3 of them (four along an axis where its box, padded
+//! for rounding, reaches just past a third cell: rarely).
 //!
 //! Its sums are its own (the photons come in another order than the
 //! kd-tree's), the same on every CPU: without AVX2 the scalar scan keeps
@@ -77,7 +78,7 @@ impl PhotonGrid {
     }
 
     /// The photons within `radius` of `point` (squared distance ≤ radius²,
-    /// as the kd-tree's `for_each_within` takes them) that arrive at the
+    /// as `PointGrid::for_each_within` takes them) that arrive at the
     /// front of `facing` (incoming · facing < 0): their summed power and
     /// count, and each one's index handed to `each`, in an order fixed by
     /// the photons and the query alone.

@@ -3,8 +3,8 @@
 //! and 2i+2, no pointers — split on the axis of largest extent, built by
 //! linear-time median selection, queried for the k nearest with a bounded
 //! max-heap on squared distances. Any record that carries a position and
-//! room for its split axis can be stored (`KdPoint`): photons, and the light
-//! vertices vertex merging gathers.
+//! room for its split axis can be stored (`KdPoint`). Queries within a
+//! radius (SPPM's gathers, VCM's merges) go to the hash grid, `cells`.
 
 use glam::Vec3;
 

@@ -1,5 +1,6 @@
 //! The photon map: photons traced from the lights into Jensen's global and
-//! caustic maps on our own kd-tree, their radiance estimate, and map files.
+//! caustic maps on our own kd-tree, their radiance estimate, and map files;
+//! and the hash grid that SPPM's gathers and VCM's merges search instead.
 
 pub mod cells;
 pub mod emit;
