@@ -18,8 +18,10 @@ use crate::render::world::lanes::LANES;
 /// Points per block of the columns filled in parallel.
 const BLOCK: usize = 1 << 14;
 
-/// Up to this many buckets a query lists on the stack.
-const FEW: usize = 27;
+/// Up to this many buckets a query lists on the stack: 4×4×4, so neither
+/// SPPM's queries (3×3×3 cells, four along an axis where the padded box
+/// reaches past a third) nor VCM's (1 to 8) allocate.
+const FEW: usize = 64;
 
 pub struct PointGrid {
     origin: Vec3,
@@ -36,6 +38,8 @@ pub struct PointGrid {
 }
 
 /// The buckets a query touches, each once, in increasing order.
+// `Few` is large on purpose: a query's list stays on the stack
+#[allow(clippy::large_enum_variant)]
 pub(super) enum Touched {
     Few([u32; FEW], usize),
     Many(Vec<u32>),

@@ -59,14 +59,6 @@ impl PhotonGrid {
         grid
     }
 
-    pub fn len(&self) -> usize {
-        self.points.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
-    }
-
     /// The direction photon `i` (an index `gather_front` handed out) travels.
     pub fn incoming(&self, i: usize) -> Vec3 {
         Vec3::new(self.incoming[0][i], self.incoming[1][i], self.incoming[2][i])
