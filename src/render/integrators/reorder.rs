@@ -4,26 +4,32 @@
 //! lanes fell.
 
 /// `records`, record i made by item `places[i]` of `0..items`, in item
-/// order, each item's in the order they were made (a stable counting
-/// sort); and where each item's records end.
+/// order, each item's in the order they were made; and where each item's
+/// records end.
 pub fn by_item<T: Copy>(records: &[T], places: &[u32], items: usize) -> (Vec<T>, Vec<u32>) {
     debug_assert_eq!(records.len(), places.len());
-    let mut first = vec![0u32; items + 1];
-    for &place in places {
-        first[place as usize + 1] += 1;
+    let (starts, order) = by_key(places, items);
+    (order.iter().map(|&i| records[i as usize]).collect(), starts[1..].to_vec())
+}
+
+/// A stable counting sort of `keys.len()` items by their keys in
+/// `0..key_count`: `order` lists the items by key, each key's in their own
+/// order, and key k's are `order[starts[k]..starts[k + 1]]`.
+pub fn by_key(keys: &[u32], key_count: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut starts = vec![0u32; key_count + 1];
+    for &key in keys {
+        starts[key as usize + 1] += 1;
     }
-    for i in 1..first.len() {
-        first[i] += first[i - 1];
+    for i in 1..starts.len() {
+        starts[i] += starts[i - 1];
     }
-    let ends = first[1..].to_vec();
-    let Some(&any) = records.first() else { return (Vec::new(), ends) };
-    let mut sorted = vec![any; records.len()];
-    for (record, &place) in records.iter().zip(places) {
-        let at = &mut first[place as usize];
-        sorted[*at as usize] = *record;
-        *at += 1;
+    let mut next = starts[..key_count].to_vec();
+    let mut order = vec![0u32; keys.len()];
+    for (item, &key) in keys.iter().enumerate() {
+        order[next[key as usize] as usize] = item as u32;
+        next[key as usize] += 1;
     }
-    (sorted, ends)
+    (starts, order)
 }
 
 #[cfg(test)]
@@ -39,5 +45,6 @@ mod tests {
         assert_eq!(sorted, ['b', 'f', 'd', 'a', 'c', 'e']);
         assert_eq!(ends, [2, 3, 6, 6]);
         assert_eq!(by_item::<char>(&[], &[], 3), (vec![], vec![0, 0, 0]));
+        assert_eq!(by_key(&places, 4), (vec![0, 2, 3, 6, 6], vec![1, 5, 3, 0, 2, 4]));
     }
 }

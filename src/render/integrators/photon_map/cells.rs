@@ -1,6 +1,6 @@
 //! A hash grid over points, for queries within a radius: cells of a chosen
 //! width, each hashed to a bucket, the points counting-sorted by bucket
-//! (linear time) into one column per coordinate. A query lists the buckets
+//! (`reorder::by_key`, linear time) into one column per coordinate. A query lists the buckets
 //! its radius box touches, each once, and tests their points. SPPM's photon
 //! grid (`grid`) scans these columns eight at a time; VCM's merges walk them
 //! for their few light vertices.
@@ -13,6 +13,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use crate::render::integrators::reorder::by_key;
 use crate::render::world::lanes::LANES;
 
 /// Points per block of the columns filled in parallel.
@@ -58,24 +59,14 @@ impl PointGrid {
             origin: if lowest.is_finite() { lowest } else { Vec3::ZERO },
             inverse_cell: 1.0 / cell,
             mask: (buckets - 1) as u32,
-            starts: vec![0; buckets + 1],
+            starts: Vec::new(),
             position: std::array::from_fn(|_| vec![0.0; count + LANES]),
-            order: vec![0; count],
+            order: Vec::new(),
         };
         let bucket_of: Vec<u32> = (0..count).into_par_iter().map(|i| grid.bucket(grid.cell_of(position(i)))).collect();
-        for &b in &bucket_of {
-            grid.starts[b as usize + 1] += 1;
-        }
-        for b in 0..buckets {
-            grid.starts[b + 1] += grid.starts[b];
-        }
         // Which point goes where, then the columns filled in order: written
         // point by point at their places, each column would miss the cache
-        let mut next = grid.starts[..buckets].to_vec();
-        for (point, &b) in bucket_of.iter().enumerate() {
-            grid.order[next[b as usize] as usize] = point as u32;
-            next[b as usize] += 1;
-        }
+        (grid.starts, grid.order) = by_key(&bucket_of, buckets);
         let [x, y, z] = &mut grid.position;
         fill_columns(&grid.order, [x, y, z], |i| position(i).to_array());
         grid
