@@ -8,12 +8,12 @@
 use glam::Vec3;
 
 use super::light_paths::{LightPaths, LightVertex};
+use super::merging::MergeGrid;
 use super::mis::{self, Partials};
 use super::strategies::{Strategy, Tally};
 use super::Context;
 use crate::geometry::Ray;
 use crate::render::integrators::next_event::PathScope;
-use crate::render::integrators::photon_map::cells::PointGrid;
 use crate::render::integrators::Counters;
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::light::{LightSample, LightSource};
@@ -26,7 +26,7 @@ use crate::scene::Rgb;
 /// merging, their vertices in a grid.
 pub struct LightSide<'a> {
     pub paths: &'a LightPaths,
-    pub grid: Option<&'a PointGrid>,
+    pub grid: Option<&'a MergeGrid>,
     pub radius: f32,
 }
 
@@ -275,8 +275,7 @@ fn merge<T: Tally>(
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
     let go_on = bsdf.continuation();
     let mut sum = Rgb::ZERO;
-    grid.for_each_within(vertex.hit.surface.point, light.radius, |index| {
-        let light_vertex = &light.paths.vertices[index as usize];
+    grid.for_each_within(vertex.hit.surface.point, light.radius, |light_vertex| {
         if light_vertex.length + vertex.length > ctx.max_length {
             return;
         }
@@ -286,7 +285,7 @@ fn merge<T: Tally>(
         }
         let camera_pdf = pdf * go_on;
         // The way back is the light vertex's to continue
-        let camera_reverse = bsdf.pdf(light_vertex.wo, wo, facing) * light_vertex.bsdf.continuation();
+        let camera_reverse = bsdf.pdf(light_vertex.wo, wo, facing) * light_vertex.continuation;
         let s = &ctx.strategies;
         let weight = mis::merge(s, &light_vertex.partials, vertex.partials, camera_pdf, camera_reverse);
         let value = light_vertex.throughput * f * weight;

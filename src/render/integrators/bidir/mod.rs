@@ -2,7 +2,7 @@
 //! and vertex connection and merging: one engine (after SmallVCM, Georgiev
 //! et al. 2012), four sets of strategies. Each pass traces one light
 //! subpath per pixel, keeps its non-specular vertices (and, to merge, a
-//! hash grid of them, `cells::PointGrid`), joins them to the camera, then
+//! hash grid of them, `merging::MergeGrid`), joins them to the camera, then
 //! traces one camera subpath per pixel that samples lights, connects to its
 //! pixel's light subpath and merges with the light vertices around it.
 //!
@@ -15,12 +15,12 @@
 
 pub mod camera_paths;
 pub mod light_paths;
+pub mod merging;
 pub mod mis;
 pub mod strategies;
 
 use rayon::prelude::*;
 
-use super::photon_map::cells::PointGrid;
 use super::photon_map::emit::LightPicker;
 use super::{Counters, PassObserver, PassReport, Stage};
 use crate::geometry::Ray;
@@ -31,6 +31,7 @@ use crate::render::world::emission::Bounds;
 use crate::render::world::light::LightSource;
 use crate::render::world::World;
 use camera_paths::LightSide;
+use merging::MergeGrid;
 use mis::Strategies;
 use strategies::{Contribution, NoTally, PixelTally, StrategyFilm};
 
@@ -101,12 +102,6 @@ impl Context<'_> {
         self.world.occluders(held).segment_blocked(ray, t_max)
     }
 }
-
-/// The merge grid's cells, in merge radii. A query touches 1 to 8 cells and
-/// finds a light vertex or two among a few dozen; measured on gap-room
-/// (VCM, 256×192, 16 passes, against the kd-tree): 2 radii 0.95 of the
-/// kd-tree's time, 4 radii 0.87–0.89, 8 radii 0.87–0.90, 1 radius 1.18.
-const MERGE_CELLS: f32 = 4.0;
 
 impl Bidir {
     /// For `settings`' method (one of the four) on `world`. The merge
@@ -191,9 +186,7 @@ impl Bidir {
         let keep_going = || observer.is_current();
         let paths = light_paths::trace(&ctx, pixels, pass as u64, self.seed, &keep_going)?;
         let radius = self.merge_radius(pass);
-        let vertices = &paths.vertices;
-        let grid =
-            weighing.merge.then(|| PointGrid::build(vertices.len(), |i| vertices[i].hit.point, radius * MERGE_CELLS));
+        let grid = weighing.merge.then(|| MergeGrid::build(&paths.vertices, radius));
         if !observer.is_current() {
             return None;
         }

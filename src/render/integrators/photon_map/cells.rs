@@ -84,15 +84,28 @@ impl PointGrid {
     /// `point` (a point exactly on the radius is in), in an order
     /// fixed by the points and the query alone.
     pub fn for_each_within(&self, point: Vec3, radius: f32, mut f: impl FnMut(u32)) {
+        self.for_each_slot_within(point, radius, |slot| f(self.order[slot]));
+    }
+
+    /// `for_each_within`'s points, each named by its slot in the grid's
+    /// order (where `in_grid_order` put its values), not by its index.
+    pub fn for_each_slot_within(&self, point: Vec3, radius: f32, mut f: impl FnMut(usize)) {
         let Some(touched) = self.touched(point, radius) else { return };
         let bound = radius * radius;
         for (start, end) in self.ranges(&touched) {
-            for i in start..end {
-                if (point - self.position_of(i)).length_squared() <= bound {
-                    f(self.order[i]);
+            for slot in start..end {
+                if (point - self.position_of(slot)).length_squared() <= bound {
+                    f(slot);
                 }
             }
         }
+    }
+
+    /// `value(i)` of every point i, in the grid's order (slot k holds
+    /// point `order[k]`'s): a query then reads its points' values in
+    /// sequence, where by index each would be a cache miss.
+    pub fn in_grid_order<T: Send>(&self, value: impl Fn(usize) -> T + Sync) -> Vec<T> {
+        self.order.par_iter().map(|&i| value(i as usize)).collect()
     }
 
     /// Sorted point `i`'s position.
@@ -258,6 +271,30 @@ pub(super) mod tests {
                 assert_eq!(within(&grid, point, radius), brute_force(&points, point, radius), "cell {cell}, {point}");
             }
         }
+    }
+
+    /// A query's slots name, through the values `in_grid_order` put there,
+    /// the points its indices name, in the same order.
+    #[test]
+    fn slots_name_the_points_indices_name() {
+        let points = scattered(3000, 2.0, 11);
+        let grid = PointGrid::build(points.len(), |i| points[i], 0.1);
+        let index_at = grid.in_grid_order(|i| i as u32);
+        let position_at = grid.in_grid_order(|i| points[i]);
+        let mut s = Sampler::new(2, 0, 11);
+        let mut found = 0;
+        for _ in 0..200 {
+            let point = Vec3::new(s.next_f32(), s.next_f32(), s.next_f32()) * 2.0;
+            let (mut by_index, mut by_slot) = (Vec::new(), Vec::new());
+            grid.for_each_within(point, 0.15, |i| by_index.push(i));
+            grid.for_each_slot_within(point, 0.15, |slot| {
+                assert_eq!(position_at[slot], grid.position_of(slot));
+                by_slot.push(index_at[slot]);
+            });
+            assert_eq!(by_slot, by_index);
+            found += by_index.len();
+        }
+        assert!(found > 200, "the queries find points ({found})");
     }
 
     /// Points within ±4 ulps of where the rim crosses each axis, around
