@@ -50,7 +50,7 @@ fn tree_result(tree: &PhotonKdTree, q: Vec3, normal: Option<Vec3>, k: usize, max
 /// Sorted squared distances of the grid's points within `radius`, in cells
 /// `cell` wide; each point at most once.
 fn grid_result(photons: &[Photon], cell: f32, q: Vec3, radius: f32) -> Vec<f32> {
-    let grid = PointGrid::build(photons.len(), |i| photons[i].position, cell);
+    let grid = PointGrid::build(photons, |p| p.position, cell);
     let mut indices = Vec::new();
     grid.for_each_within(q, radius, |i| indices.push(i));
     let mut unique = indices.clone();

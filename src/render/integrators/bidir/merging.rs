@@ -55,8 +55,8 @@ impl MergeGrid {
                 partials: v.partials,
             })
             .collect();
-        let points = PointGrid::build(positions.len(), |i| positions[i], radius * MERGE_CELLS);
-        let vertices = points.in_grid_order(|i| merged[i]);
+        let points = PointGrid::build(&positions, |&p| p, radius * MERGE_CELLS);
+        let vertices = points.in_grid_order(&merged);
         Self { points, vertices }
     }
 

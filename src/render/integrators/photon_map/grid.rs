@@ -46,14 +46,14 @@ impl PhotonGrid {
     }
 
     fn build_scanning(photons: &[Photon], cell: f32, lanes: bool) -> Self {
-        let points = PointGrid::build(photons.len(), |i| photons[i].position, cell);
+        let points = PointGrid::build(photons, |p| p.position, cell);
         let padded = || vec![0.0; photons.len() + LANES];
         let mut grid =
             Self { points, incoming: [padded(), padded(), padded()], power: [padded(), padded(), padded()], lanes };
         let [ix, iy, iz] = &mut grid.incoming;
         let [pr, pg, pb] = &mut grid.power;
-        fill_columns(&grid.points.order, [ix, iy, iz, pr, pg, pb], |i| {
-            let (d, p) = (photons[i].incoming_direction(), photons[i].power);
+        fill_columns(&grid.points.order, [ix, iy, iz, pr, pg, pb], photons, |photon| {
+            let (d, p) = (photon.incoming_direction(), photon.power);
             [d.x, d.y, d.z, p[0], p[1], p[2]]
         });
         grid

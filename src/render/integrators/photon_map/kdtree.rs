@@ -9,6 +9,7 @@
 use glam::Vec3;
 
 use crate::render::integrators::photon_map::record::Photon;
+use crate::render::integrators::reorder::{prefetch, PREFETCH_AHEAD};
 
 /// What the tree stores: a position, and the split axis of its node.
 pub trait KdPoint: Copy + Default + Send {
@@ -141,22 +142,6 @@ fn to_heap_order<P: KdPoint>(records: &[P], keys: &[Key], axes: &[u8]) -> Vec<P>
         next += 1;
         node = 2 * stack[top] + 2;
     }
-}
-
-/// How many records ahead the heap-order walk asks for.
-const PREFETCH_AHEAD: usize = 16;
-
-/// A hint to bring `value`'s cache line in; nothing else.
-#[inline(always)]
-#[allow(unsafe_code)]
-fn prefetch<T>(value: &T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: prefetching reads nothing and cannot fault; the pointer is a reference's
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>((value as *const T).cast::<i8>())
-    };
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = value;
 }
 
 impl<P: KdPoint> KdTree<P> {
