@@ -11,7 +11,7 @@
 
 use glam::Vec3;
 
-use super::cells::{fill_columns, PointGrid, Touched};
+use super::cells::{eight, fill_columns, PointGrid, Touched};
 use super::record::Photon;
 #[cfg(target_arch = "x86_64")]
 use crate::render::world::lanes;
@@ -163,11 +163,6 @@ struct Query {
     point: Vec3,
     bound: f32,
     facing: Vec3,
-}
-
-#[inline(always)]
-fn eight(v: &[f32], i: usize) -> &[f32; LANES] {
-    v[i..i + LANES].try_into().expect("the arrays are padded by LANES")
 }
 
 fn lane_total(lanes: [f32; LANES]) -> f32 {
