@@ -42,19 +42,21 @@ impl MergeGrid {
     /// The grid of `vertices` for merges within `radius` (cells
     /// `MERGE_CELLS` radii wide).
     pub fn build(vertices: &[LightVertex], radius: f32) -> Self {
-        // Both read in sequence here, so that only small records are
-        // gathered in the grid's order
-        let positions: Vec<Vec3> = vertices.par_iter().map(|v| v.hit.point).collect();
-        let merged: Vec<MergeVertex> = vertices
+        // The vertices read in sequence here, so that only small records
+        // are gathered in the grid's order
+        let (positions, merged): (Vec<Vec3>, Vec<MergeVertex>) = vertices
             .par_iter()
-            .map(|v| MergeVertex {
-                wo: v.wo,
-                length: v.length,
-                throughput: v.throughput,
-                continuation: v.bsdf.continuation(),
-                partials: v.partials,
+            .map(|v| {
+                let merged = MergeVertex {
+                    wo: v.wo,
+                    length: v.length,
+                    throughput: v.throughput,
+                    continuation: v.bsdf.continuation(),
+                    partials: v.partials,
+                };
+                (v.hit.point, merged)
             })
-            .collect();
+            .unzip();
         let points = PointGrid::build(&positions, |&p| p, radius * MERGE_CELLS);
         let vertices = points.in_grid_order(&merged);
         Self { points, vertices }
