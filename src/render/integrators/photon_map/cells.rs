@@ -38,8 +38,9 @@ pub struct PointGrid {
     pub(super) position: [Vec<f32>; 3],
     /// Each sorted point's index in the points the grid was built from.
     pub(super) order: Vec<u32>,
-    /// Test points eight at a time (false: one at a time, the same slots).
-    lanes: bool,
+    /// Test points eight at a time, with AVX2 on x86-64 (false: one at a
+    /// time, the same slots; SPPM's grid scans alike).
+    pub(super) lanes: bool,
 }
 
 /// The buckets a query touches, each once, in increasing order.

@@ -13,8 +13,6 @@ use glam::Vec3;
 
 use super::cells::{eight, fill_columns, PointGrid, Touched};
 use super::record::Photon;
-#[cfg(target_arch = "x86_64")]
-use crate::render::world::lanes;
 use crate::render::world::lanes::{F8, LANES};
 
 /// What a gather found: the photons' summed power, and how many.
@@ -30,26 +28,17 @@ pub struct PhotonGrid {
     /// points' order and padded as their columns are.
     incoming: [Vec<f32>; 3],
     power: [Vec<f32>; 3],
-    /// Scan with AVX2 (false: the scalar scan, which sums the same bits).
-    lanes: bool,
 }
 
 impl PhotonGrid {
     /// The grid of `photons` for queries of radius up to `cell` (larger
     /// radii are answered too, touching more cells).
+    /// Scanned eight at a time where the points' grid tests them so
+    /// (`PointGrid::lanes`), else by the scalar scan, which sums the same bits.
     pub fn build(photons: &[Photon], cell: f32) -> Self {
-        #[cfg(target_arch = "x86_64")]
-        let lanes = lanes::supported();
-        #[cfg(not(target_arch = "x86_64"))]
-        let lanes = true;
-        Self::build_scanning(photons, cell, lanes)
-    }
-
-    fn build_scanning(photons: &[Photon], cell: f32, lanes: bool) -> Self {
         let points = PointGrid::build(photons, |p| p.position, cell);
         let padded = || vec![0.0; photons.len() + LANES];
-        let mut grid =
-            Self { points, incoming: [padded(), padded(), padded()], power: [padded(), padded(), padded()], lanes };
+        let mut grid = Self { points, incoming: [padded(), padded(), padded()], power: [padded(), padded(), padded()] };
         let [ix, iy, iz] = &mut grid.incoming;
         let [pr, pg, pb] = &mut grid.power;
         fill_columns(&grid.points.order, [ix, iy, iz, pr, pg, pb], photons, |photon| {
@@ -78,13 +67,13 @@ impl PhotonGrid {
         let Some(touched) = self.points.touched(point, radius) else { return FrontSum::default() };
         let query = Query { point, bound: radius * radius, facing };
         #[cfg(target_arch = "x86_64")]
-        if self.lanes {
+        if self.points.lanes {
             // SAFETY: `lanes` is set only where the CPU has AVX2.
             #[allow(unsafe_code)]
             return unsafe { self.scan_avx2(&touched, &query, &mut each) };
         }
         #[cfg(not(target_arch = "x86_64"))]
-        if self.lanes {
+        if self.points.lanes {
             return self.scan_lanes(&touched, &query, &mut each);
         }
         self.scan_scalar(&touched, &query, &mut each)
@@ -238,8 +227,9 @@ mod tests {
     fn the_lanes_and_the_scalar_scan_agree_bit_for_bit() {
         assert!(crate::render::world::lanes::supported(), "this test runs where the lanes do");
         let photons = photons(3000, 2.0, 11);
-        let lanes = PhotonGrid::build_scanning(&photons, 0.15, true);
-        let scalar = PhotonGrid::build_scanning(&photons, 0.15, false);
+        let lanes = PhotonGrid::build(&photons, 0.15);
+        let mut scalar = PhotonGrid::build(&photons, 0.15);
+        scalar.points.lanes = false;
         let mut s = Sampler::new(2, 0, 11);
         let mut nonempty = 0;
         for _ in 0..400 {

@@ -2,47 +2,20 @@
 //! one flat array in left-balanced heap order — children of node i at 2i+1
 //! and 2i+2, no pointers — split on the axis of largest extent, built by
 //! linear-time median selection, queried for the k nearest with a bounded
-//! max-heap on squared distances. Any record that carries a position and
-//! room for its split axis can be stored (`KdPoint`). Queries within a
-//! radius (SPPM's gathers, VCM's merges) go to the hash grid, `cells`.
+//! max-heap on squared distances. Queries within a radius (SPPM's gathers,
+//! VCM's merges) go to the hash grid, `cells`.
 
 use glam::Vec3;
 
 use crate::render::integrators::photon_map::record::Photon;
 use crate::render::integrators::reorder::{prefetch, PREFETCH_AHEAD};
 
-/// What the tree stores: a position, and the split axis of its node.
-pub trait KdPoint: Copy + Default + Send {
-    fn position(&self) -> Vec3;
-    fn axis(&self) -> usize;
-    fn set_axis(&mut self, axis: usize);
-}
-
-impl KdPoint for Photon {
-    #[inline]
-    fn position(&self) -> Vec3 {
-        self.position
-    }
-
-    #[inline]
-    fn axis(&self) -> usize {
-        Photon::axis(self)
-    }
-
-    #[inline]
-    fn set_axis(&mut self, axis: usize) {
-        Photon::set_axis(self, axis)
-    }
-}
-
+/// The photon map.
 #[derive(Debug)]
-pub struct KdTree<P: KdPoint> {
-    photons: Vec<P>,
+pub struct PhotonKdTree {
+    photons: Vec<Photon>,
     depth: usize,
 }
-
-/// The photon map.
-pub type PhotonKdTree = KdTree<Photon>;
 
 /// Nodes in the left subtree of a left-balanced tree of `n` nodes: the last
 /// level fills from the left, so the left subtree is complete first.
@@ -116,9 +89,9 @@ fn partition(keys: &mut [Key], axes: &mut [u8]) {
 /// their axes, into heap order: an in-order walk of the heap's indices
 /// meets the nodes in that order, so it takes the keys in sequence (a stack
 /// of the left spine, no subtree sizes).
-fn to_heap_order<P: KdPoint>(records: &[P], keys: &[Key], axes: &[u8]) -> Vec<P> {
+fn to_heap_order(records: &[Photon], keys: &[Key], axes: &[u8]) -> Vec<Photon> {
     let n = keys.len();
-    let mut tree = vec![P::default(); n];
+    let mut tree = vec![Photon::default(); n];
     // A node's depth is below 64 for any n that fits in memory
     let mut stack = [0usize; 64];
     let (mut top, mut node, mut next) = (0, 0, 0);
@@ -144,7 +117,7 @@ fn to_heap_order<P: KdPoint>(records: &[P], keys: &[Key], axes: &[u8]) -> Vec<P>
     }
 }
 
-impl<P: KdPoint> KdTree<P> {
+impl PhotonKdTree {
     /// Balance `photons` into a left-balanced tree in O(n log n): each
     /// segment of their keys (position and index, whatever a record's size)
     /// is partitioned in place about its median on the axis of its points'
@@ -152,12 +125,12 @@ impl<P: KdPoint> KdTree<P> {
     /// segment's median then sits at its split, so the keys end in the
     /// tree's in-order, and one in-order walk writes the records they name
     /// in heap order. The tree is the same on any number of threads.
-    pub fn build(photons: Vec<P>) -> Self {
+    pub fn build(photons: Vec<Photon>) -> Self {
         let n = photons.len();
         // Indices fit in u32, as the queries' stacks assume: the limits keep
         // every tree far smaller
         let mut keys: Vec<Key> =
-            photons.iter().enumerate().map(|(i, p)| Key { position: p.position(), record: i as u32 }).collect();
+            photons.iter().enumerate().map(|(i, p)| Key { position: p.position, record: i as u32 }).collect();
         let mut axes = vec![0u8; n];
         partition(&mut keys, &mut axes);
         Self { photons: to_heap_order(&photons, &keys, &axes), depth: depth_of(n) }
@@ -167,7 +140,7 @@ impl<P: KdPoint> KdTree<P> {
     /// the first photon out of place) unless every split holds, since the
     /// queries prune by them: each photon lies inside the box its ancestors'
     /// splits leave it (left of a split ≤, right ≥, on that split's axis).
-    pub fn from_heap_order(photons: Vec<P>) -> Result<Self, usize> {
+    pub fn from_heap_order(photons: Vec<Photon>) -> Result<Self, usize> {
         let n = photons.len();
         // (node, lower and upper bounds from its ancestors): O(n) in all
         let mut stack = Vec::with_capacity(128);
@@ -175,7 +148,7 @@ impl<P: KdPoint> KdTree<P> {
             stack.push((0usize, Vec3::NEG_INFINITY, Vec3::INFINITY));
         }
         while let Some((node, lo, hi)) = stack.pop() {
-            let p = photons[node].position();
+            let p = photons[node].position;
             if !(p.cmpge(lo).all() && p.cmple(hi).all()) {
                 return Err(node);
             }
@@ -205,16 +178,14 @@ impl<P: KdPoint> KdTree<P> {
     }
 
     /// Heap-ordered photons; `Neighbours` indices point here.
-    pub fn photons(&self) -> &[P] {
+    pub fn photons(&self) -> &[Photon] {
         &self.photons
     }
 
     pub fn bytes(&self) -> usize {
         std::mem::size_of_val(self.photons.as_slice())
     }
-}
 
-impl PhotonKdTree {
     /// The `k` nearest photons to `position` within `max_radius` (inclusive)
     /// into `out`; with a `normal`, only photons arriving at its front side.
     /// Returns the number of nodes visited.
