@@ -532,6 +532,13 @@ impl PathLanes {
         for sphere in &self.spheres {
             if sphere.wall.is_none() || !every_held {
                 let f = origin - V8::splat(sphere.center);
+                // No lane's line meets it: no root to solve (`roots`' discriminant)
+                let b = f.dot(direction);
+                let discriminant = F8::splat(sphere.radius2) - (f - direction * b).length_squared();
+                if !discriminant.ge(F8::splat(0.0)).and(active).any() {
+                    k = k + 1.0;
+                    continue;
+                }
                 let (t, closer, _) = nearest_root(f, direction, F8::splat(sphere.radius2), t_hit);
                 let closer = if sphere.wall.is_some() { closer.and_not(held) } else { closer };
                 t_hit = closer.select(t, t_hit);
