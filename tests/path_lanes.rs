@@ -240,3 +240,101 @@ fn the_seam_of_the_light_and_the_ceiling_bit_for_bit() {
     let lit = assert_lanes_match_scalar(&scene, 4, 2);
     assert!(lit > 100, "only {lit} samples carried light");
 }
+
+/// Shadow rays traced together, eight at a time (what the bidirectional
+/// methods do with their connections and light samples), are blocked
+/// exactly where `World::blocked` blocks each alone: on every preset, on
+/// the Cornell box seen from outside its walls (which its shadow rays must
+/// then test) and with a second, triangle, light; toward light samples
+/// (skipping the light's own sphere or plane of triangles), between the
+/// vertices of a path, and in batches that do not split into eights.
+#[test]
+fn shadow_rays_in_lanes_are_blocked_as_one_at_a_time() {
+    use gi_studio::geometry::Ray;
+    use gi_studio::render::world::light::{Emitter, LightSource};
+    use gi_studio::render::world::occluders::Shadow;
+    use gi_studio::render::world::rng::Sampler;
+    use gi_studio::render::world::sampling::uniform_sphere;
+    let mut scenes: Vec<(String, Scene)> = presets::names().map(|n| (n.to_string(), preset(n))).collect();
+    // A lens reaching past the right wall's plane: paths not held inside the walls
+    let mut outside = preset("cornell");
+    outside.camera.position = Vec3::new(0.9, 1.0, 3.4);
+    outside.camera.aperture_radius = 0.3;
+    outside.camera.focus_distance = 3.0;
+    scenes.push(("cornell from outside".into(), outside));
+    let mut lamps = preset("gap-room");
+    let lamp = lamps.objects.iter().position(|o| o.name == "lamp").expect("gap-room's lamp");
+    let shape =
+        Shape::Triangle { a: Vec3::new(-2.9, 2.4, -1.0), b: Vec3::new(-2.9, 2.4, 0.0), c: Vec3::new(-2.9, 1.6, -0.5) };
+    lamps.objects.push(Object { name: "panel".into(), shape, ..lamps.objects[lamp].clone() });
+    scenes.push(("gap-room with a panel".into(), lamps));
+    for (name, scene) in &scenes {
+        let (world, camera) = world(scene, 64, 48);
+        let lanes = PathLanes::new(&world).expect("a scene the lanes trace");
+        let mut s = Sampler::new(0, 0, 9);
+        let mut shadows = Vec::new();
+        // Straight through each light triangle to beyond it: only what it
+        // ends on (its plane's triangles) is skipped
+        for light in &world.lights {
+            if let LightSource::Area { emitter: Emitter::Triangle { triangle, shape }, .. } = light {
+                let [a, b, c] = shape.vertices;
+                for k in 0..40 {
+                    let target = (a + b + c) / 3.0 + (b - a) * (k as f32 / 100.0);
+                    let from = target + shape.normal * 0.5 + Vec3::new(0.01, 0.02, 0.03) * k as f32;
+                    let (segment, t_max) =
+                        (Ray::new(from, (target - from).normalize()), 2.0 * (target - from).length());
+                    let held = world.holds(from);
+                    shadows.push(Shadow { on_triangle: Some(*triangle), ..Shadow::segment(segment, t_max, held) });
+                }
+            }
+        }
+        let tile = CameraTile {
+            camera: &camera,
+            rect: TileRect { x: 0, y: 0, width: 64, height: 48 },
+            streams: PassStreams::new(0, 9),
+        };
+        for i in 0..600 {
+            let mut ray = tile.sample(i * 5).0;
+            let held = world.holds(ray.origin);
+            let mut vertices = Vec::new();
+            for _ in 0..4 {
+                let Some(hit) = world.intersect_held(&ray, f32::INFINITY, held) else { break };
+                for light in &world.lights {
+                    if let Some(sample) = light.sample(&hit.surface, s.next_2d()) {
+                        shadows.push(Shadow::toward(&sample, held));
+                    }
+                }
+                for earlier in &vertices {
+                    let (segment, t_max) = hit.surface.spawn_ray_to(*earlier, 0.0);
+                    shadows.push(Shadow::segment(segment, t_max, held));
+                }
+                vertices.push(hit.surface.point);
+                let mut direction = uniform_sphere(s.next_2d());
+                if direction.dot(hit.surface.normal) * (-ray.direction).dot(hit.surface.normal) < 0.0 {
+                    direction = -direction;
+                }
+                ray = hit.surface.spawn_ray(direction);
+            }
+        }
+        let expected: Vec<bool> = shadows.iter().map(|shadow| world.blocked(shadow)).collect();
+        // Batches of every length up to three eights and a bit
+        let (mut at, mut length) = (0, 1);
+        while at < shadows.len() {
+            let end = (at + length).min(shadows.len());
+            let mut got = vec![false; end - at];
+            lanes.shadows_blocked(&world, &shadows[at..end], &mut got);
+            assert_eq!(got, expected[at..end], "{name}: shadow rays {at}..{end}");
+            (at, length) = (end, length % 27 + 1);
+        }
+        let blocked = expected.iter().filter(|&&b| b).count();
+        let loose = shadows.iter().filter(|shadow| !shadow.held).count();
+        if name.ends_with("from outside") {
+            assert!(loose > shadows.len() / 4, "{name}: only {loose} shadow rays not held");
+        }
+        assert!(
+            blocked > shadows.len() / 50 && blocked < shadows.len() * 49 / 50,
+            "{name}: {blocked} of {} blocked",
+            shadows.len()
+        );
+    }
+}

@@ -1,9 +1,9 @@
-//! Items that fly from hit to hit on their own (photons, light subpaths),
-//! eight at a time: their rays meet the world in the paths' eight-lane hit
-//! loop (`PathLanes::intersect8`), and each goes on from its hit by itself,
-//! in scalar code. A lane whose item ends takes the next one, so the lanes
-//! stay busy however far items go; items end out of turn, so what they
-//! make is tagged with their place for `reorder`.
+//! Items that fly from hit to hit on their own (photons, light and camera
+//! subpaths), eight at a time: their rays meet the world in the paths'
+//! eight-lane hit loop (`PathLanes::intersect8`), and each goes on from its
+//! hit by itself, in scalar code. A lane whose item ends takes the next
+//! one, so the lanes stay busy however far items go; items end out of
+//! turn, so what they make is tagged with their place for `reorder`.
 
 use std::ops::Range;
 
@@ -16,7 +16,8 @@ use crate::render::world::{Hit, World};
 /// `ray` is its next ray and whether it started inside every wall (as
 /// `World::intersect_held` takes it; asked once for each ray traced), and
 /// `bounce` carries it on from the nearest hit (false: it ends there), told
-/// the item's place in `indices`. A ray that meets nothing ends its item.
+/// the item's place in `indices`; told None where the ray meets nothing,
+/// which ends the item whatever it says.
 /// Eight at a time through `path_lanes` where given and the CPU has AVX2;
 /// one at a time otherwise, with the same calls for each item in the same
 /// order.
@@ -26,7 +27,7 @@ pub fn fly<T>(
     indices: Range<u64>,
     launch: impl FnMut(u64) -> Option<T>,
     ray: impl FnMut(&T) -> (Ray, bool),
-    bounce: impl FnMut(u32, &mut T, &Hit) -> bool,
+    bounce: impl FnMut(u32, &mut T, Option<&Hit>) -> bool,
 ) {
     let Some(path_lanes) = path_lanes.filter(|_| PathLanes::runs_in_lanes()) else {
         return fly_one_at_a_time(world, indices, launch, ray, bounce);
@@ -44,15 +45,15 @@ fn fly_one_at_a_time<T>(
     indices: Range<u64>,
     mut launch: impl FnMut(u64) -> Option<T>,
     mut ray: impl FnMut(&T) -> (Ray, bool),
-    mut bounce: impl FnMut(u32, &mut T, &Hit) -> bool,
+    mut bounce: impl FnMut(u32, &mut T, Option<&Hit>) -> bool,
 ) {
     for index in indices.clone() {
         let Some(mut item) = launch(index) else { continue };
         let place = (index - indices.start) as u32;
         loop {
             let (next, held) = ray(&item);
-            let Some(hit) = world.intersect_held(&next, f32::INFINITY, held) else { break };
-            if !bounce(place, &mut item, &hit) {
+            let hit = world.intersect_held(&next, f32::INFINITY, held);
+            if !bounce(place, &mut item, hit.as_ref()) || hit.is_none() {
                 break;
             }
         }
@@ -67,7 +68,7 @@ fn fly_avx2<T>(
     indices: Range<u64>,
     launch: impl FnMut(u64) -> Option<T>,
     ray: impl FnMut(&T) -> (Ray, bool),
-    bounce: impl FnMut(u32, &mut T, &Hit) -> bool,
+    bounce: impl FnMut(u32, &mut T, Option<&Hit>) -> bool,
 ) {
     fly_lanes(path_lanes, world, indices, launch, ray, bounce)
 }
@@ -79,7 +80,7 @@ fn fly_lanes<T>(
     indices: Range<u64>,
     mut launch: impl FnMut(u64) -> Option<T>,
     mut ray: impl FnMut(&T) -> (Ray, bool),
-    mut bounce: impl FnMut(u32, &mut T, &Hit) -> bool,
+    mut bounce: impl FnMut(u32, &mut T, Option<&Hit>) -> bool,
 ) {
     let mut flying: [Option<(u32, T)>; LANES] = Default::default();
     let mut next = indices.start;
@@ -97,7 +98,7 @@ fn fly_lanes<T>(
         let hits = path_lanes.intersect8(world, &rays);
         for (slot, hit) in flying.iter_mut().zip(&hits) {
             let Some((place, item)) = slot else { continue };
-            if !hit.as_ref().is_some_and(|hit| bounce(*place, item, hit)) {
+            if !bounce(*place, item, hit.as_ref()) || hit.is_none() {
                 *slot = None;
             }
         }

@@ -12,6 +12,7 @@ pub mod path_lanes;
 pub mod photon;
 pub mod photon_map;
 pub mod reorder;
+pub mod shadow_batch;
 pub mod specular;
 pub mod sppm;
 pub mod whitted;

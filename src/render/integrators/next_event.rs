@@ -52,10 +52,26 @@ impl<'w> PathScope<'w> {
         counters: &mut Counters,
         shade: impl FnOnce(&LightSample) -> Option<T>,
     ) -> Option<(LightSample, T)> {
+        let (sample, value) = self.unshadowed_light_sample(light, hit, u, counters, shade)?;
+        (!self.occluders.blocks(&sample)).then_some((sample, value))
+    }
+
+    /// `light_sample` short of its shadow ray, counted as traced: for a
+    /// caller that traces it later (`Shadow::toward` the sample, with this
+    /// path's `held`).
+    #[inline]
+    pub fn unshadowed_light_sample<T>(
+        &self,
+        light: &LightSource,
+        hit: &Hit,
+        u: Vec2,
+        counters: &mut Counters,
+        shade: impl FnOnce(&LightSample) -> Option<T>,
+    ) -> Option<(LightSample, T)> {
         let sample = light.sample(&hit.surface, u)?;
         let value = shade(&sample)?;
         counters.rays += 1;
-        (!self.occluders.blocks(&sample)).then_some((sample, value))
+        Some((sample, value))
     }
 
     /// Direct light from one light chosen uniformly, weighted against BSDF

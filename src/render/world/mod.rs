@@ -23,7 +23,7 @@ use crate::geometry::{Ray, SurfaceHit, Triangle};
 use crate::scene::{LightKind, MaterialModel, Rgb, Shape, ValidScene};
 use camera::CameraModel;
 use light::{Emitter, EmitterCap, LightSource};
-use occluders::{Occluders, Walls};
+use occluders::{Occluders, Shadow, Walls};
 pub use shapes::{ObjectInfo, PlaneShape, ShapeRef, Spheres};
 use spheres::SphereLanes;
 use triangles::TriangleLanes;
@@ -286,6 +286,13 @@ impl World {
         let s = self;
         let triangles = (&s.triangles[..], &s.triangle_lanes);
         Occluders::for_path(&s.walls, &s.spheres.lanes, &s.planes, triangles, &s.light_plane, held)
+    }
+
+    /// Whether anything blocks `shadow` (tested against what can block it
+    /// from where it starts, `occluders`).
+    #[inline]
+    pub fn blocked(&self, shadow: &Shadow) -> bool {
+        self.occluders(shadow.held).blocks_shadow(shadow)
     }
 
     /// `intersect` for a path `held` inside every wall (`holds` of where it

@@ -280,20 +280,53 @@ impl<'w> Occluders<'w> {
     /// path vertices, or of one to the camera).
     #[inline]
     pub fn segment_blocked(&self, ray: &Ray, t_max: f32) -> bool {
-        self.spheres.any_hit_except(ray, t_max, None)
-            || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
-            || self.triangle_lanes.any_hit(self.triangles, ray, t_max, |_| false)
+        self.blocks_shadow(&Shadow::segment(*ray, t_max, false))
     }
 
     /// Whether anything lies between the shading point and the light sample.
     #[inline]
     pub fn blocks(&self, sample: &LightSample) -> bool {
-        let (ray, t_max) = (&sample.shadow, sample.shadow_t_max);
-        let light_plane = sample.on_triangle.map(|t| self.light_plane[t as usize]);
-        self.spheres.any_hit_except(ray, t_max, sample.on_sphere)
+        self.blocks_shadow(&Shadow::toward(sample, false))
+    }
+
+    /// Whether anything but what `shadow` ends on lies on it (its `held`
+    /// is this path's, which chose the occluders).
+    #[inline]
+    pub fn blocks_shadow(&self, shadow: &Shadow) -> bool {
+        let (ray, t_max) = (&shadow.ray, shadow.t_max);
+        let light_plane = shadow.on_triangle.map(|t| self.light_plane[t as usize]);
+        self.spheres.any_hit_except(ray, t_max, shadow.on_sphere)
             || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
             || (self.triangle_lanes)
                 .any_hit(self.triangles, ray, t_max, |i| light_plane == Some(self.light_plane[i as usize]))
+    }
+}
+
+/// A shadow ray to trace: the segment, whether both its ends lie inside
+/// every wall (which it then cannot cross), and what it ends on, which it
+/// meets only at its end: the sphere or the triangle (and so the plane of
+/// triangles) a light sample lies on.
+#[derive(Clone, Copy, Debug)]
+pub struct Shadow {
+    pub ray: Ray,
+    pub t_max: f32,
+    pub held: bool,
+    pub on_sphere: Option<u32>,
+    pub on_triangle: Option<u32>,
+}
+
+impl Shadow {
+    /// Between two points of paths (or one and the camera): nothing to skip.
+    #[inline]
+    pub fn segment(ray: Ray, t_max: f32, held: bool) -> Self {
+        Shadow { ray, t_max, held, on_sphere: None, on_triangle: None }
+    }
+
+    /// Toward a light sample, from a path `held` inside every wall or not.
+    #[inline]
+    pub fn toward(sample: &LightSample, held: bool) -> Self {
+        let (on_sphere, on_triangle) = (sample.on_sphere, sample.on_triangle);
+        Shadow { ray: sample.shadow, t_max: sample.shadow_t_max, held, on_sphere, on_triangle }
     }
 }
 

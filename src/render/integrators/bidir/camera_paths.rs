@@ -4,19 +4,30 @@
 //! light vertex within the merge radius; where the path meets an emitter or
 //! the background, their light. Each is weighed against every other
 //! strategy that could have made the same path (`mis`).
+//!
+//! A tile's subpaths fly eight at a time (`flying`: their rays through the
+//! paths' hit loop), and each keeps what it finds, in order, until it ends:
+//! then its shadow rays are traced together, eight at a time, and what gets
+//! through is added up in the order it was found. So the pixel is the sum
+//! tracing each ray at once would make, bit for bit.
+
+use std::cell::RefCell;
 
 use glam::Vec3;
 
 use super::light_paths::{LightPaths, LightVertex};
 use super::merging::MergeGrid;
 use super::mis::{self, Partials};
-use super::strategies::{Strategy, Tally};
+use super::strategies::{Contribution, NoTally, PixelTally, Strategy, Tally};
 use super::Context;
 use crate::geometry::Ray;
 use crate::render::integrators::next_event::PathScope;
-use crate::render::integrators::Counters;
+use crate::render::integrators::shadow_batch::ShadowBatch;
+use crate::render::integrators::{flying, reorder, Counters};
 use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::camera::CameraTile;
 use crate::render::world::light::{LightSample, LightSource};
+use crate::render::world::occluders::Shadow;
 use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::uniform_sphere_pdf;
 use crate::render::world::Hit;
@@ -41,89 +52,245 @@ struct CameraVertex<'a> {
     length: u32,
 }
 
-/// The light of pixel `pixel`'s camera subpath starting along `ray`, each
-/// strategy's part also told to `tally`.
-pub fn radiance<T: Tally>(
+/// What a camera subpath found, in the order it found it, to add once its
+/// shadow rays are traced.
+#[derive(Default)]
+struct Found {
+    terms: Vec<Term>,
+    shadows: Vec<Shadow>,
+}
+
+/// One strategy's part: `throughput · value` (weighed `weight`), nothing
+/// if its shadow ray (an index into `Found::shadows`) is blocked. Told to
+/// the strategy view as `tally` (a merge, merge by merge), added to the
+/// pixel if `color` (a pixel's merges as their sum).
+struct Term {
+    tally: Option<Strategy>,
+    color: bool,
+    throughput: Rgb,
+    value: Rgb,
+    weight: f32,
+    shadow: Option<u32>,
+}
+
+impl Found {
+    /// A part that waits on its shadow ray (None: nothing, weighed 0).
+    fn shadowed(&mut self, strategy: Strategy, throughput: Rgb, part: Option<(Rgb, f32, Shadow)>) {
+        let (value, weight, shadow) = match part {
+            Some((value, weight, shadow)) => {
+                self.shadows.push(shadow);
+                (value, weight, Some(self.shadows.len() as u32 - 1))
+            }
+            None => (Rgb::ZERO, 0.0, None),
+        };
+        self.terms.push(Term { tally: Some(strategy), color: true, throughput, value, weight, shadow });
+    }
+
+    /// A part that needs no shadow ray.
+    fn seen(&mut self, tally: Option<Strategy>, color: bool, value: Rgb, weight: f32) {
+        self.terms.push(Term { tally, color, throughput: Rgb::ONE, value, weight, shadow: None });
+    }
+
+    /// The parts that the shadow rays let through (`batch` has traced them
+    /// from index `first` on), told to `tally` and added up in order.
+    fn sum<T: Tally>(&mut self, batch: &ShadowBatch, first: u32, tally: &mut T) -> Rgb {
+        let mut color = Rgb::ZERO;
+        for term in &self.terms {
+            let blocked = term.shadow.is_some_and(|i| batch.blocked(first + i));
+            let (value, weight) = if blocked { (Rgb::ZERO, 0.0) } else { (term.value, term.weight) };
+            let part = term.throughput * value;
+            if let Some(strategy) = term.tally {
+                tally.add(strategy, part, weight);
+            }
+            if term.color {
+                color += part;
+            }
+        }
+        self.terms.clear();
+        color
+    }
+}
+
+/// Paths that ended, waiting for their shadow rays, which are traced
+/// together once there are `WAITING` of them (a few batches of eight) or
+/// as many paths: each path's place, small pixel, what it found, and where
+/// its shadow rays start in `shadows`.
+struct Ended {
+    paths: Vec<(u32, u32, Found, u32)>,
+    shadows: ShadowBatch,
+}
+
+const WAITING: usize = 32;
+
+/// One camera subpath between its vertices.
+struct CameraPath<'w> {
+    /// Its pixel in the film, and (for the strategy view) its small pixel.
+    pixel: usize,
+    small_pixel: u32,
+    sampler: Sampler,
+    scope: PathScope<'w>,
+    partials: Partials,
+    throughput: Rgb,
+    ray: Ray,
+    last_point: Vec3,
+    specular_path: bool,
+    /// Segments from the camera, `ray`'s included.
+    length: u32,
+    found: Found,
+}
+
+/// The light of every camera sample of `tile` (of a film `width` wide),
+/// into `out`; what each strategy brought, for the strategy view, into
+/// `contributions` in the order of the samples.
+pub fn trace(
     ctx: &Context,
     light: &LightSide,
-    pixel: usize,
-    ray: Ray,
-    sampler: &mut Sampler,
+    tile: &CameraTile,
+    width: u32,
     counters: &mut Counters,
-    tally: &mut T,
-) -> Rgb {
-    let (world, s) = (ctx.world, &ctx.strategies);
-    let scope = PathScope::new(world, ray.origin);
-    let mut partials = Partials::camera(s, ctx.camera.ray_pdf(ray.direction));
-    let (mut throughput, mut color) = (Rgb::ONE, Rgb::ZERO);
-    let (mut ray, mut last_point, mut specular_path) = (ray, ray.origin, true);
-    for length in 1..ctx.max_length + 1 {
-        counters.rays += 1;
-        let Some(hit) = scope.intersect(&ray) else {
-            let weight = background_weight(ctx, &partials, length, specular_path, last_point, ray.direction);
+    out: &mut [Rgb],
+    contributions: &mut Vec<Contribution>,
+) {
+    // What paths that ended leave for those that start
+    let spare = RefCell::new(Vec::<Found>::new());
+    let (start, count) = (contributions.len(), out.len());
+    let mut places = Vec::new();
+    let launch = |i: u64| {
+        if ctx.max_length == 0 {
+            return None;
+        }
+        let (x, y) = tile.rect.pixel(i as usize);
+        let (ray, sampler) = tile.sample(i as usize);
+        let scope = PathScope::new(ctx.world, ray.origin);
+        Some(CameraPath {
+            pixel: (y * width + x) as usize,
+            small_pixel: ctx.strategy_film.map_or(0, |film| film.pixel(x, y)),
+            sampler,
+            scope,
+            partials: Partials::camera(&ctx.strategies, ctx.camera.ray_pdf(ray.direction)),
+            throughput: Rgb::ONE,
+            ray,
+            last_point: ray.origin,
+            specular_path: true,
+            length: 1,
+            found: spare.borrow_mut().pop().unwrap_or_default(),
+        })
+    };
+    let mut rays = 0;
+    let ray = |path: &CameraPath| {
+        rays += 1;
+        (path.ray, path.scope.held)
+    };
+    let mut ended = Ended { paths: Vec::new(), shadows: ShadowBatch::default() };
+    // The ended paths' shadow rays traced, their light into `out`
+    let mut finish = |ended: &mut Ended, contributions: &mut Vec<Contribution>| {
+        ended.shadows.trace(ctx.path_lanes, ctx.world);
+        for (place, small_pixel, mut found, first) in ended.paths.drain(..) {
+            out[place as usize] = match ctx.strategy_film {
+                Some(_) => found.sum(&ended.shadows, first, &mut PixelTally { pixel: small_pixel, out: contributions }),
+                None => found.sum(&ended.shadows, first, &mut NoTally),
+            };
+            places.resize(contributions.len() - start, place);
+            spare.borrow_mut().push(found);
+        }
+        ended.shadows.clear();
+    };
+    let bounce = |place: u32, path: &mut CameraPath, hit: Option<&Hit>| {
+        if path.bounce(ctx, light, hit, counters) {
+            return true;
+        }
+        let mut found = std::mem::take(&mut path.found);
+        let first = ended.shadows.append(&mut found.shadows);
+        ended.paths.push((place, path.small_pixel, found, first));
+        if ended.shadows.count() as usize >= WAITING || ended.paths.len() >= WAITING {
+            finish(&mut ended, contributions);
+        }
+        false
+    };
+    flying::fly(ctx.path_lanes, ctx.world, 0..count as u64, launch, ray, bounce);
+    finish(&mut ended, contributions);
+    counters.rays += rays;
+    if !places.is_empty() {
+        let ordered = reorder::by_item(&contributions[start..], &places, count).0;
+        contributions.truncate(start);
+        contributions.extend(ordered);
+    }
+}
+
+impl CameraPath<'_> {
+    /// The path's vertex at `hit`, the nearest along its ray (None: it
+    /// left the scene): what it finds there, then its next ray. False once
+    /// the path ends.
+    fn bounce(&mut self, ctx: &Context, light: &LightSide, hit: Option<&Hit>, counters: &mut Counters) -> bool {
+        let (world, s) = (ctx.world, &ctx.strategies);
+        let length = self.length;
+        let throughput = self.throughput;
+        let Some(hit) = hit else {
+            let weight =
+                background_weight(ctx, &self.partials, length, self.specular_path, self.last_point, self.ray.direction);
             let value = throughput * world.background * weight;
-            tally.add(Strategy::Connect { length, light_vertices: 0 }, value, weight);
-            color += value;
-            break;
+            self.found.seen(Some(Strategy::Connect { length, light_vertices: 0 }), true, value, weight);
+            return false;
         };
-        let (wo, n) = (-ray.direction, hit.surface.normal);
+        let (wo, n) = (-self.ray.direction, hit.surface.normal);
         // The camera's density is per solid angle at the lens, not at the
         // near clip the first ray starts from
         let distance =
-            if length == 1 { hit.surface.t + ctx.camera.clip_distance(ray.direction) } else { hit.surface.t };
-        partials.arrive(s, Some(distance * distance), wo.dot(n));
-        let emitted = world.emitted(&hit, wo);
+            if length == 1 { hit.surface.t + ctx.camera.clip_distance(self.ray.direction) } else { hit.surface.t };
+        self.partials.arrive(s, Some(distance * distance), wo.dot(n));
+        let emitted = world.emitted(hit, wo);
         if emitted != Rgb::ZERO {
-            let weight = emitter_weight(ctx, &partials, length, specular_path, &hit, wo, last_point);
+            let weight = emitter_weight(ctx, &self.partials, length, self.specular_path, hit, wo, self.last_point);
             let value = throughput * emitted * weight;
-            tally.add(Strategy::Connect { length, light_vertices: 0 }, value, weight);
-            color += value;
+            self.found.seen(Some(Strategy::Connect { length, light_vertices: 0 }), true, value, weight);
         }
         // Light tracing's camera paths only see what shines straight at them
-        let bsdf = Bsdf::new(world.material_of(&hit));
+        let bsdf = Bsdf::new(world.material_of(hit));
         if ctx.light_tracing || matches!(bsdf, Bsdf::Black) || length >= ctx.max_length {
-            break;
+            return false;
         }
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
+        let sampler = &mut self.sampler;
         if !bsdf.is_specular() {
-            let vertex = CameraVertex { hit: &hit, wo, facing, bsdf: &bsdf, partials: &partials, length };
+            let vertex = CameraVertex { hit, wo, facing, bsdf: &bsdf, partials: &self.partials, length };
             if s.connect {
-                let (value, weight) = direct(ctx, &scope, &vertex, sampler, counters);
-                tally.add(Strategy::Connect { length: length + 1, light_vertices: 1 }, throughput * value, weight);
-                color += throughput * value;
-                for light_vertex in light.paths.path(pixel) {
+                let part = direct(ctx, &self.scope, &vertex, sampler, counters);
+                let strategy = Strategy::Connect { length: length + 1, light_vertices: 1 };
+                self.found.shadowed(strategy, throughput, part);
+                for light_vertex in light.paths.path(self.pixel) {
                     if light_vertex.length + 1 + length > ctx.max_length {
                         break;
                     }
-                    let (value, weight) = connect(ctx, &scope, &vertex, light_vertex, counters);
+                    let part = connect(ctx, &self.scope, &vertex, light_vertex, counters);
                     let strategy = Strategy::Connect {
                         length: light_vertex.length + 1 + length,
                         light_vertices: light_vertex.length + 1,
                     };
-                    tally.add(strategy, throughput * value, weight);
-                    color += throughput * value;
+                    self.found.shadowed(strategy, throughput, part);
                 }
             }
             if s.merge {
-                color += merge(ctx, light, &vertex, throughput, counters, tally);
+                let sum = merge(ctx, light, &vertex, throughput, counters, &mut self.found);
+                self.found.seen(None, true, sum, 0.0);
             }
         }
-        let Some(scattered) = bsdf.sample(wo, n, sampler, Transport::Radiance) else { break };
+        let Some(scattered) = bsdf.sample(wo, n, sampler, Transport::Radiance) else { return false };
         let go_on = bsdf.continuation();
         if sampler.next_f32() >= go_on {
-            break;
+            return false;
         }
         let reverse = if scattered.delta { scattered.pdf } else { bsdf.pdf(scattered.wi, wo, facing) };
-        partials.scatter(s, scattered.pdf * go_on, reverse * go_on, scattered.wi.dot(n), scattered.delta);
-        throughput *= scattered.weight / go_on;
-        specular_path &= scattered.delta;
-        if throughput == Rgb::ZERO {
-            break;
+        self.partials.scatter(s, scattered.pdf * go_on, reverse * go_on, scattered.wi.dot(n), scattered.delta);
+        self.throughput *= scattered.weight / go_on;
+        self.specular_path &= scattered.delta;
+        if self.throughput == Rgb::ZERO {
+            return false;
         }
-        last_point = hit.surface.point;
-        ray = hit.surface.spawn_ray(scattered.wi);
+        self.last_point = hit.surface.point;
+        self.ray = hit.surface.spawn_ray(scattered.wi);
+        self.length += 1;
+        true
     }
-    color
 }
 
 /// The weight of an emitter met by a camera subpath of `length` segments,
@@ -181,23 +348,20 @@ fn background_weight(
 }
 
 /// Next-event estimation (s = 1): a light chosen by power, a sample of it;
-/// its contribution and MIS weight.
+/// its contribution and MIS weight, and the shadow ray that decides them.
 fn direct(
     ctx: &Context,
     scope: &PathScope,
     vertex: &CameraVertex,
     sampler: &mut Sampler,
     counters: &mut Counters,
-) -> (Rgb, f32) {
-    let none = (Rgb::ZERO, 0.0);
-    let Some((index, pick)) = ctx.picker.pick(sampler.next_f32()) else { return none };
+) -> Option<(Rgb, f32, Shadow)> {
+    let (index, pick) = ctx.picker.pick(sampler.next_f32())?;
     let light = &ctx.world.lights[index];
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
     let shade = |sample: &LightSample| Some(bsdf.eval_pdf(wo, sample.wi, facing)).filter(|(f, _)| *f != Rgb::ZERO);
     counters.connections += 1;
-    let Some((sample, (f, pdf))) = scope.light_sample(light, vertex.hit, sampler.next_2d(), counters, shade) else {
-        return none;
-    };
+    let (sample, (f, pdf)) = scope.unshadowed_light_sample(light, vertex.hit, sampler.next_2d(), counters, shade)?;
     let point = vertex.hit.surface.point;
     let (direct_pdf, cos_at_light) = match light {
         LightSource::Point { .. } | LightSource::Spot { .. } => ((sample.point - point).length_squared(), 1.0),
@@ -214,31 +378,30 @@ fn direct(
     let cos = sample.wi.dot(facing);
     let (s, partials) = (&ctx.strategies, vertex.partials);
     let weight = mis::direct(s, partials, bsdf_pdf, reverse, pick, direct_pdf, emission_pdf, cos, cos_at_light);
-    (f * sample.value * (cos * weight / pick), weight)
+    Some((f * sample.value * (cos * weight / pick), weight, Shadow::toward(&sample, scope.held)))
 }
 
 /// A camera vertex connected to a vertex of the pixel's light subpath:
-/// its contribution and MIS weight.
+/// its contribution and MIS weight, and the shadow ray that decides them.
 fn connect(
     ctx: &Context,
     scope: &PathScope,
     vertex: &CameraVertex,
     light: &LightVertex,
     counters: &mut Counters,
-) -> (Rgb, f32) {
-    let none = (Rgb::ZERO, 0.0);
+) -> Option<(Rgb, f32, Shadow)> {
     let to_light = light.hit.point - vertex.hit.surface.point;
     let distance2 = to_light.length_squared();
     let direction = to_light / distance2.sqrt();
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
     let (camera_f, camera_pdf) = bsdf.eval_pdf(wo, direction, facing);
     if camera_f == Rgb::ZERO {
-        return none;
+        return None;
     }
     let light_facing = light.facing();
     let (light_f, light_pdf) = light.bsdf.eval_pdf(light.wo, -direction, light_facing);
     if light_f == Rgb::ZERO {
-        return none;
+        return None;
     }
     let (cos_camera, cos_light) = (direction.dot(facing), -direction.dot(light_facing));
     let (camera_go_on, light_go_on) = (bsdf.continuation(), light.bsdf.continuation());
@@ -252,23 +415,23 @@ fn connect(
     let contribution = light.throughput * camera_f * light_f * (weight * cos_camera * cos_light / distance2);
     counters.connections += 1;
     counters.rays += 1;
-    let (shadow, t_max) = vertex.hit.surface.spawn_ray_to(light.hit.point, light.hit.error);
-    if contribution == Rgb::ZERO || ctx.blocked(scope.held && light.held, &shadow, t_max) {
-        return none;
+    if contribution == Rgb::ZERO {
+        return None;
     }
-    (contribution, weight)
+    let (shadow, t_max) = vertex.hit.surface.spawn_ray_to(light.hit.point, light.hit.error);
+    Some((contribution, weight, Shadow::segment(shadow, t_max, scope.held && light.held)))
 }
 
 /// Every light vertex within the merge radius, merged into the camera
 /// vertex: the light it brings (times `throughput`), as a density estimate
-/// on the radius's disc.
-fn merge<T: Tally>(
+/// on the radius's disc; each merge kept for the strategy view, if open.
+fn merge(
     ctx: &Context,
     light: &LightSide,
     vertex: &CameraVertex,
     throughput: Rgb,
     counters: &mut Counters,
-    tally: &mut T,
+    found: &mut Found,
 ) -> Rgb {
     let Some(grid) = light.grid else { return Rgb::ZERO };
     let normalization = ctx.strategies.vm_normalization;
@@ -289,10 +452,87 @@ fn merge<T: Tally>(
         let s = &ctx.strategies;
         let weight = mis::merge(s, &light_vertex.partials, vertex.partials, camera_pdf, camera_reverse);
         let value = light_vertex.throughput * f * weight;
-        let strategy = Strategy::Merge { length: light_vertex.length + vertex.length, camera_vertex: vertex.length };
-        tally.add(strategy, throughput * value * normalization, weight);
+        if ctx.strategy_film.is_some() {
+            let strategy =
+                Strategy::Merge { length: light_vertex.length + vertex.length, camera_vertex: vertex.length };
+            found.seen(Some(strategy), false, throughput * value * normalization, weight);
+        }
         sum += value;
         counters.merges += 1;
     });
     throughput * sum * normalization
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::integrators::bidir::light_paths;
+    use crate::render::integrators::bidir::mis::Strategies;
+    use crate::render::integrators::bidir::strategies::StrategyFilm;
+    use crate::render::integrators::path_lanes::PathLanes;
+    use crate::render::integrators::photon_map::emit::LightPicker;
+    use crate::render::settings::MisHeuristic;
+    use crate::render::world::camera::{CameraModel, TileRect};
+    use crate::render::world::rng::PassStreams;
+    use crate::render::world::World;
+    use crate::scene::presets;
+
+    /// Every preset, connecting and merging (VCM), the strategy view open
+    /// or not: the camera subpaths of a tile flown eight at a time, their
+    /// shadow rays traced in lanes, make what one at a time with every
+    /// shadow ray alone makes — the same pixels, contributions and counts,
+    /// bit for bit.
+    #[test]
+    fn eight_at_a_time_make_what_one_at_a_time_make() {
+        assert!(PathLanes::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
+        let (width, height) = (40, 30);
+        let film = StrategyFilm::new(width, height);
+        for name in presets::names() {
+            let scene = presets::preset(name).and_then(Result::ok).expect("preset");
+            let camera = CameraModel::new(&scene.camera, width, height);
+            let (world, visible_radius) = World::for_view(&scene, &camera, width, height);
+            let path_lanes = PathLanes::new(&world).expect("a world the lanes trace");
+            let picker = LightPicker::new(&world);
+            let pixels = (width * height) as f32;
+            let radius = visible_radius * 0.01;
+            for strategy_film in [None, Some(&film)] {
+                let lanes_ctx = Context {
+                    world: &world,
+                    path_lanes: Some(&path_lanes),
+                    camera: &camera,
+                    strategies: Strategies::new(MisHeuristic::Power, true, true, pixels, radius),
+                    picker: &picker,
+                    bounds: world.bounds(),
+                    background: world.lights.iter().position(|l| matches!(l, LightSource::Background { .. })),
+                    max_length: 8,
+                    light_tracing: false,
+                    strategy_film,
+                };
+                let scalar_ctx = Context { path_lanes: None, ..lanes_ctx };
+                let paths = light_paths::trace(&lanes_ctx, pixels as u64, 2, 5, &|| true).expect("not cancelled");
+                let grid = MergeGrid::build(&paths.vertices, radius);
+                let light = LightSide { paths: &paths, grid: Some(&grid), radius };
+                // A tile that does not split into eights, away from the corner
+                let rect = TileRect { x: 3, y: 5, width: 29, height: 11 };
+                let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(2, 5) };
+                let run = |ctx: &Context| {
+                    let (mut counters, mut values, mut contributions) =
+                        (Counters::default(), vec![Rgb::splat(-1.0); rect.pixels()], Vec::new());
+                    trace(ctx, &light, &tile, width, &mut counters, &mut values, &mut contributions);
+                    let bits: Vec<[u32; 3]> = values.iter().map(|v| v.to_array().map(f32::to_bits)).collect();
+                    (bits, format!("{contributions:?}"), format!("{counters:?}"))
+                };
+                let (eight, one) = (run(&lanes_ctx), run(&scalar_ctx));
+                let view = strategy_film.is_some();
+                assert!(eight.0 == one.0, "{name}, view {view}: the pixels differ");
+                assert_eq!(eight.1, one.1, "{name}, view {view}: the contributions differ");
+                assert_eq!(eight.2, one.2, "{name}, view {view}");
+                let lit = eight.0.iter().filter(|v| v.iter().any(|&c| c != 0)).count();
+                assert!(lit > rect.pixels() / 4, "{name}: only {lit} pixels lit");
+                if view {
+                    assert!(eight.1.len() > 100, "{name}: no contributions");
+                }
+            }
+        }
+    }
 }

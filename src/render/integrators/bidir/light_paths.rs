@@ -14,15 +14,17 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::mis::{self, Partials};
-use super::strategies::{Contribution, PixelTally, Strategy, Tally};
+use super::strategies::{Contribution, PixelTally, Strategy};
 use super::Context;
 use crate::geometry::{Ray, SurfaceHit};
 use crate::render::film::Splat;
 use crate::render::integrators::next_event::PathScope;
 use crate::render::integrators::path_lanes::PathLanes;
+use crate::render::integrators::shadow_batch::ShadowBatch;
 use crate::render::integrators::{flying, reorder, Counters};
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::light::LightSource;
+use crate::render::world::occluders::Shadow;
 use crate::render::world::rng::Sampler;
 use crate::render::world::Hit;
 use crate::scene::Rgb;
@@ -93,7 +95,6 @@ pub fn trace(
     seed: u64,
     keep_going: &(dyn Fn() -> bool + Sync),
 ) -> Option<LightPaths> {
-    let path_lanes = PathLanes::new(ctx.world);
     let chunks = count.div_ceil(CHUNK) as usize;
     let per_chunk: Option<Vec<ChunkPaths>> = (0..chunks)
         .into_par_iter()
@@ -103,7 +104,7 @@ pub fn trace(
                 return None;
             }
             let indices = chunk as u64 * CHUNK..((chunk as u64 + 1) * CHUNK).min(count);
-            Some(Flights { ctx, pass, seed }.trace(path_lanes.as_ref(), indices))
+            Some(Flights { ctx, pass, seed }.trace(ctx.path_lanes, indices))
         })
         .collect();
     let mut paths = LightPaths {
@@ -132,6 +133,54 @@ struct ChunkPaths {
     splats: Vec<Splat>,
     contributions: Vec<Contribution>,
     counters: Counters,
+    /// Joins to the camera whose shadow rays are still to trace.
+    joins: Joins,
+}
+
+/// Joins to the camera, kept until `JOINS` of them are asked for, then
+/// their shadow rays traced together and what gets through made splats.
+#[derive(Default)]
+struct Joins {
+    waiting: Vec<Join>,
+    shadows: ShadowBatch,
+    /// Which path made each splat and contribution made so far: its place
+    /// in the chunk.
+    splat_places: Vec<u32>,
+    contribution_places: Vec<u32>,
+}
+
+/// Joins traced together: a few batches of eight.
+const JOINS: usize = 64;
+
+/// A join to the camera whose shadow ray is still to trace: its splat and
+/// (for the strategy view) contribution, if nothing blocks it.
+struct Join {
+    splat: Splat,
+    contribution: Option<Contribution>,
+    shadow: u32,
+    /// Which path made it: its place in the chunk.
+    place: u32,
+}
+
+impl ChunkPaths {
+    /// The waiting joins' shadow rays traced; those that get through
+    /// become splats (and contributions), in the order they were made.
+    fn trace_joins(&mut self, ctx: &Context) {
+        let joins = &mut self.joins;
+        joins.shadows.trace(ctx.path_lanes, ctx.world);
+        for join in joins.waiting.drain(..) {
+            if joins.shadows.blocked(join.shadow) {
+                continue;
+            }
+            self.splats.push(join.splat);
+            joins.splat_places.push(join.place);
+            if let Some(contribution) = join.contribution {
+                self.contributions.push(contribution);
+                joins.contribution_places.push(join.place);
+            }
+        }
+        joins.shadows.clear();
+    }
 }
 
 /// One light subpath between its vertices.
@@ -186,7 +235,7 @@ impl<'w> Flights<'_, 'w> {
     /// The path's vertex at `hit`, the nearest along its ray: kept and
     /// joined to the camera unless specular, then scattered. False once
     /// the path ends.
-    fn bounce(&self, path: &mut Flight, hit: &Hit, out: &mut ChunkPaths) -> bool {
+    fn bounce(&self, place: u32, path: &mut Flight, hit: &Hit, out: &mut ChunkPaths) -> bool {
         let ctx = self.ctx;
         let (world, s) = (ctx.world, &ctx.strategies);
         let (light, pick, length) = (path.light, path.pick, path.length);
@@ -207,7 +256,7 @@ impl<'w> Flights<'_, 'w> {
                 out.vertices.push(vertex);
             }
             if s.connect || ctx.light_tracing {
-                join_camera(ctx, &path.scope, &vertex, sampler, out);
+                join_camera(ctx, &path.scope, &vertex, sampler, place, out);
             }
         }
         // A longer path would have no strategy left to finish it
@@ -237,33 +286,44 @@ impl<'w> Flights<'_, 'w> {
     fn trace(&self, path_lanes: Option<&PathLanes>, indices: Range<u64>) -> ChunkPaths {
         let mut out = ChunkPaths::default();
         // Which path made each vertex, splat and contribution: its place among `indices`
-        let mut places: [Vec<u32>; 3] = Default::default();
+        let mut places = Vec::new();
         let mut rays = 0;
         let ray = |path: &Flight| {
             rays += 1;
             (path.ray, path.scope.held)
         };
-        let bounce = |place, path: &mut Flight, hit: &Hit| {
-            let goes_on = self.bounce(path, hit, &mut out);
-            places[0].resize(out.vertices.len(), place);
-            places[1].resize(out.splats.len(), place);
-            places[2].resize(out.contributions.len(), place);
+        let bounce = |place, path: &mut Flight, hit: Option<&Hit>| {
+            let Some(hit) = hit else { return false };
+            let goes_on = self.bounce(place, path, hit, &mut out);
+            places.resize(out.vertices.len(), place);
+            if out.joins.waiting.len() >= JOINS {
+                out.trace_joins(self.ctx);
+            }
             goes_on
         };
         let count = (indices.end - indices.start) as usize;
         flying::fly(path_lanes, self.ctx.world, indices, |index| self.launch(index), ray, bounce);
         out.counters.rays += rays;
-        (out.vertices, out.ends) = reorder::by_item(&out.vertices, &places[0], count);
-        out.splats = reorder::by_item(&out.splats, &places[1], count).0;
-        out.contributions = reorder::by_item(&out.contributions, &places[2], count).0;
+        out.trace_joins(self.ctx);
+        (out.vertices, out.ends) = reorder::by_item(&out.vertices, &places, count);
+        out.splats = reorder::by_item(&out.splats, &out.joins.splat_places, count).0;
+        out.contributions = reorder::by_item(&out.contributions, &out.joins.contribution_places, count).0;
         out
     }
 }
 
 /// A light vertex joined to the camera (t = 1): a splat on the pixel it
 /// lands on, weighed against every other strategy for the same path
-/// (plain light tracing weighs it 1: it is the only one it has).
-fn join_camera(ctx: &Context, scope: &PathScope, vertex: &LightVertex, sampler: &mut Sampler, out: &mut ChunkPaths) {
+/// (plain light tracing weighs it 1: it is the only one it has), once its
+/// shadow ray, traced with others (`ChunkPaths::trace_joins`), gets through.
+fn join_camera(
+    ctx: &Context,
+    scope: &PathScope,
+    vertex: &LightVertex,
+    sampler: &mut Sampler,
+    place: u32,
+    out: &mut ChunkPaths,
+) {
     let lens = if ctx.camera.has_lens() { sampler.next_2d() } else { glam::Vec2::ZERO };
     let Some(seen) = ctx.camera.connect(vertex.hit.point, lens) else { return };
     let facing = vertex.facing();
@@ -284,17 +344,19 @@ fn join_camera(ctx: &Context, scope: &PathScope, vertex: &LightVertex, sampler: 
     let t_max = t_max - seen.start;
     out.counters.connections += 1;
     out.counters.rays += 1;
-    // Inside every wall at both ends, the segment cannot cross one
-    let held = scope.held && ctx.world.holds(seen.lens - seen.to_camera * seen.start);
-    if t_max <= 0.0 || ctx.blocked(held, &shadow, t_max) {
+    if t_max <= 0.0 {
         return;
     }
-    out.splats.push(Splat { x: seen.pixel.0, y: seen.pixel.1, value });
-    if let Some(film) = ctx.strategy_film {
+    // Inside every wall at both ends, the segment cannot cross one
+    let held = scope.held && ctx.world.holds(seen.lens - seen.to_camera * seen.start);
+    let shadow = out.joins.shadows.push(Shadow::segment(shadow, t_max, held));
+    let contribution = ctx.strategy_film.and_then(|film| {
         let pixel = film.pixel(seen.pixel.0, seen.pixel.1);
         let strategy = Strategy::Connect { length: vertex.length + 1, light_vertices: vertex.length + 1 };
-        PixelTally { pixel, out: &mut out.contributions }.add(strategy, value, weight);
-    }
+        PixelTally::contribution(pixel, strategy, value, weight)
+    });
+    let splat = Splat { x: seen.pixel.0, y: seen.pixel.1, value };
+    out.joins.waiting.push(Join { splat, contribution, shadow, place });
 }
 
 #[cfg(test)]
@@ -311,8 +373,9 @@ mod tests {
     /// Every preset, and each way the light subpaths are used (light
     /// tracing, connecting, merging, both; the strategy view open or not;
     /// paths of two segments at most and of eight):
-    /// eight at a time, the paths make what they make one at a time — the
-    /// same vertices, ends, splats, contributions and counts, bit for bit.
+    /// eight at a time, their shadow rays eight at a time, the paths make
+    /// what they make one at a time — the same vertices, ends, splats,
+    /// contributions and counts, bit for bit.
     #[test]
     fn eight_at_a_time_make_what_one_at_a_time_make() {
         assert!(PathLanes::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
@@ -330,8 +393,9 @@ mod tests {
             for (max_length, (connect, merge, light_tracing)) in ways.iter().flat_map(|&w| [(2, w), (8, w)]) {
                 for strategy_film in [None, Some(&film)] {
                     let pixels = (width * height) as f32;
-                    let ctx = Context {
+                    let lanes_ctx = Context {
                         world: &world,
+                        path_lanes: Some(&path_lanes),
                         camera: &camera,
                         strategies: Strategies::new(MisHeuristic::Power, connect, merge, pixels, visible_radius * 0.01),
                         picker: &picker,
@@ -341,11 +405,12 @@ mod tests {
                         light_tracing,
                         strategy_film,
                     };
-                    let flights = Flights { ctx: &ctx, pass: 3, seed: 11 };
+                    // One at a time with shadow rays one at a time too
+                    let scalar_ctx = Context { path_lanes: None, ..lanes_ctx };
                     // Not a multiple of eight, away from 0
                     let indices = 100..1123;
-                    let one = flights.trace(None, indices.clone());
-                    let eight = flights.trace(Some(&path_lanes), indices);
+                    let one = Flights { ctx: &scalar_ctx, pass: 3, seed: 11 }.trace(None, indices.clone());
+                    let eight = Flights { ctx: &lanes_ctx, pass: 3, seed: 11 }.trace(Some(&path_lanes), indices);
                     let view = strategy_film.is_some();
                     let what = format!("{name}, connect {connect}, merge {merge}, view {view}, {max_length} segments");
                     let vertex_bits = |paths: &ChunkPaths| format!("{:?}", paths.vertices);

@@ -21,19 +21,20 @@ pub mod strategies;
 
 use rayon::prelude::*;
 
+use super::path_lanes::PathLanes;
 use super::photon_map::emit::LightPicker;
 use super::{Counters, PassObserver, PassReport, Stage};
-use crate::geometry::Ray;
 use crate::render::film::{Film, TermSums};
 use crate::render::settings::{Algorithm, Method, MisHeuristic, RenderSettings};
 use crate::render::world::camera::{CameraModel, CameraTile};
 use crate::render::world::emission::Bounds;
 use crate::render::world::light::LightSource;
 use crate::render::world::World;
+use crate::scene::Rgb;
 use camera_paths::LightSide;
 use merging::MergeGrid;
 use mis::Strategies;
-use strategies::{Contribution, NoTally, PixelTally, StrategyFilm};
+use strategies::{Contribution, StrategyFilm};
 
 /// Bidirectional work of one pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -69,11 +70,16 @@ pub struct Bidir {
     picker: LightPicker,
     /// What each strategy brought so far, while the view asks for it.
     strategy_film: Option<StrategyFilm>,
+    /// The world compiled for eight rays at a time, for the light subpaths'
+    /// flights and every shadow ray.
+    path_lanes: Option<Box<PathLanes>>,
 }
 
 /// What the subpaths of a pass share.
 pub struct Context<'a> {
     pub world: &'a World,
+    /// The world for eight rays at a time, where it can be compiled.
+    pub path_lanes: Option<&'a PathLanes>,
     pub camera: &'a CameraModel,
     pub strategies: Strategies,
     pub picker: &'a LightPicker,
@@ -93,13 +99,6 @@ impl Context<'_> {
     /// Whether light vertices are kept (to connect or merge).
     pub fn keeps_vertices(&self) -> bool {
         self.strategies.connect || self.strategies.merge
-    }
-
-    /// Whether anything blocks `ray` before `t_max`; `held`: both ends
-    /// inside every wall, which it then cannot cross.
-    #[inline]
-    pub fn blocked(&self, held: bool, ray: &Ray, t_max: f32) -> bool {
-        self.world.occluders(held).segment_blocked(ray, t_max)
     }
 }
 
@@ -130,6 +129,7 @@ impl Bidir {
             seed: settings.seed,
             picker: LightPicker::new(world),
             strategy_film: None,
+            path_lanes: PathLanes::new(world).map(Box::new),
         }
     }
 
@@ -174,6 +174,7 @@ impl Bidir {
         let background = world.lights.iter().position(|l| matches!(l, LightSource::Background { .. }));
         let ctx = Context {
             world,
+            path_lanes: self.path_lanes.as_deref(),
             camera: stage.camera,
             strategies: weighing,
             picker: &self.picker,
@@ -203,20 +204,10 @@ impl Bidir {
                     return (counters, contributions);
                 }
                 let camera_tile = CameraTile { camera: stage.camera, rect: tile.rect, streams };
-                for i in 0..tile.rect.pixels() {
-                    let (x, y) = tile.rect.pixel(i);
-                    let (ray, mut sampler) = camera_tile.sample(i);
-                    let pixel = (y * width + x) as usize;
-                    let (sampler, counters) = (&mut sampler, &mut counters);
-                    let value = match ctx.strategy_film {
-                        Some(small) => {
-                            let mut tally = PixelTally { pixel: small.pixel(x, y), out: &mut contributions };
-                            camera_paths::radiance(&ctx, &light, pixel, ray, sampler, counters, &mut tally)
-                        }
-                        None => camera_paths::radiance(&ctx, &light, pixel, ray, sampler, counters, &mut NoTally),
-                    };
-                    let value = stage.accept(value, counters).unwrap_or_default();
-                    tile.add(i, value);
+                let mut values = vec![Rgb::ZERO; tile.rect.pixels()];
+                camera_paths::trace(&ctx, &light, &camera_tile, width, &mut counters, &mut values, &mut contributions);
+                for (i, value) in values.into_iter().enumerate() {
+                    tile.add(i, stage.accept(value, &mut counters).unwrap_or_default());
                 }
                 (counters, contributions)
             })

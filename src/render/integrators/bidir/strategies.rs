@@ -101,13 +101,17 @@ pub struct PixelTally<'a> {
     pub out: &'a mut Vec<Contribution>,
 }
 
+impl PixelTally<'_> {
+    /// What `add` keeps: a shown strategy's part that brought light.
+    pub fn contribution(pixel: u32, strategy: Strategy, weighted: Rgb, weight: f32) -> Option<Contribution> {
+        let cell = strategy.index()?;
+        (weighted != Rgb::ZERO && weight > 0.0).then_some(Contribution { cell: cell as u32, pixel, weighted, weight })
+    }
+}
+
 impl Tally for PixelTally<'_> {
     fn add(&mut self, strategy: Strategy, weighted: Rgb, weight: f32) {
-        if let Some(cell) = strategy.index() {
-            if weighted != Rgb::ZERO && weight > 0.0 {
-                self.out.push(Contribution { cell: cell as u32, pixel: self.pixel, weighted, weight });
-            }
-        }
+        self.out.extend(Self::contribution(self.pixel, strategy, weighted, weight));
     }
 }
 

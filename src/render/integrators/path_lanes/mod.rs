@@ -33,6 +33,7 @@ use crate::render::world::bsdf::{blinn_normalisation, reflect_of, refraction_of,
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSource};
+use crate::render::world::occluders::Shadow;
 use crate::render::world::sampling::{cosine_hemisphere_of, power_heuristic, power_heuristic_of, uniform_sphere_pdf};
 use crate::render::world::{Hit, ShapeRef, World};
 use crate::scene::{MaterialModel, Rgb};
@@ -433,7 +434,13 @@ impl PathLanes {
             let shade = light.valid.and(above).and(f.nonzero());
             counters.rays += shade.count();
             if shade.any() {
-                let blocked = self.blocked(shade, st.inside_walls, light.origin, light.wi, light.t_max, &pick);
+                let skips = if light_count == 1 {
+                    Skips::All { sphere: self.light_spheres[0], plane: self.light_planes[0] }
+                } else {
+                    let spheres = lanes::each(|i| self.light_spheres[pick[i]]);
+                    Skips::Lanes { spheres, planes: lanes::each(|i| self.light_planes[pick[i]]) }
+                };
+                let blocked = self.blocked(shade, st.inside_walls, light.origin, light.wi, light.t_max, &skips);
                 let lit = shade.and_not(blocked);
                 if lit.any() {
                     let cos = light.wi.dot(facing);
@@ -744,17 +751,20 @@ impl PathLanes {
     }
 
     /// Lanes of `mask` whose shadow ray (origin, unit direction, t_max) is
-    /// blocked by a sphere; paths inside every wall skip the walls.
+    /// blocked; paths inside every wall skip the walls, and each ray what
+    /// `skips` says it ends on (`Occluders::blocks_shadow`).
     #[inline(always)]
-    fn blocked(&self, mask: M8, inside_walls: M8, origin: V8, direction: V8, t_max: F8, pick: &[usize; LANES]) -> M8 {
+    #[allow(clippy::too_many_arguments)]
+    fn blocked(&self, mask: M8, inside_walls: M8, origin: V8, direction: V8, t_max: F8, skips: &Skips) -> M8 {
         let mut blocked = M8::NONE;
         // Plain loops: a closure here would not inherit AVX2
         for sphere in &self.others {
-            let aimed_at = match sphere.emitter {
-                // Every sample lies on the one light: no shadow ray can meet it
-                Some(_) if self.light_spheres.len() == 1 => continue,
-                Some(id) => M8::from_fn(|i| self.light_spheres[pick[i]] == Some(id)),
-                None => M8::NONE,
+            let aimed_at = match (sphere.emitter, skips) {
+                (None, _) => M8::NONE,
+                // Every ray ends on it: none can meet it
+                (Some(id), Skips::All { sphere, .. }) if *sphere == Some(id) => continue,
+                (Some(_), Skips::All { .. }) => M8::NONE,
+                (Some(id), Skips::Lanes { spheres, .. }) => M8::from_fn(|i| spheres[i] == Some(id)),
             };
             blocked = blocked.or(Self::hits(sphere, origin, direction, t_max).and_not(aimed_at));
         }
@@ -771,22 +781,78 @@ impl PathLanes {
                 blocked = blocked.or(if plane.wall.is_some() { outside.and(hits) } else { hits });
             }
         }
-        // Triangles where the ray may reach them, but those in
-        // the plane of the light's own triangle (`Occluders::blocks`)
+        // Triangles where the ray may reach them, but those in the plane of
+        // the light triangle a ray ends on
         let shear = ray_shear_of(origin, direction);
-        let light_plane: [Option<u32>; LANES] = lanes::each(|i| self.light_planes[pick[i]]);
-        let any_light_plane = light_plane.iter().any(Option::is_some);
         for (j, (triangle, plane)) in self.triangles.iter().zip(&self.triangle_planes).enumerate() {
-            let mut near = self.may_reach(j, mask.and_not(blocked), origin, direction, t_max);
-            if any_light_plane {
-                near = near.and_not(M8::from_fn(|i| light_plane[i] == Some(*plane)));
-            }
+            let aimed_at = match skips {
+                Skips::All { plane: skip, .. } if *skip == Some(*plane) => continue,
+                Skips::All { .. } => M8::NONE,
+                Skips::Lanes { planes, .. } => M8::from_fn(|i| planes[i] == Some(*plane)),
+            };
+            let near = self.may_reach(j, mask.and_not(blocked).and_not(aimed_at), origin, direction, t_max);
             if near.any() {
                 blocked = blocked.or(Self::triangle_hits(triangle, near, origin, direction, &shear, t_max).0);
             }
         }
         mask.and(blocked)
     }
+
+    /// Which of `shadows` something blocks (`blocked[i]` says of
+    /// `shadows[i]`): `World::blocked` of each, bit for bit, eight at a time
+    /// where the CPU has AVX2.
+    pub fn shadows_blocked(&self, world: &World, shadows: &[Shadow], blocked: &mut [bool]) {
+        if !lanes::supported() {
+            return shadows.iter().zip(blocked).for_each(|(shadow, out)| *out = world.blocked(shadow));
+        }
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: the CPU has AVX2 (`lanes::supported`).
+        #[allow(unsafe_code)]
+        unsafe {
+            self.shadows_blocked_avx2(shadows, blocked)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        self.shadows_blocked_lanes(shadows, blocked);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn shadows_blocked_avx2(&self, shadows: &[Shadow], blocked: &mut [bool]) {
+        self.shadows_blocked_lanes(shadows, blocked);
+    }
+
+    #[inline(always)]
+    fn shadows_blocked_lanes(&self, shadows: &[Shadow], blocked: &mut [bool]) {
+        for (eight, out) in shadows.chunks(LANES).zip(blocked.chunks_mut(LANES)) {
+            let n = eight.len();
+            let mask = M8::from_bits((1 << n) - 1);
+            let lane = |i: usize| &eight[i.min(n - 1)];
+            let origin = V8::from_fn(|i| lane(i).ray.origin);
+            let direction = V8::from_fn(|i| lane(i).ray.direction);
+            let t_max = F8::from_fn(|i| lane(i).t_max);
+            let held = M8::from_fn(|i| lane(i).held);
+            let spheres = lanes::each(|i| lane(i).on_sphere);
+            let planes = lanes::each(|i| lane(i).on_triangle.map(|t| self.triangle_planes[t as usize]));
+            let hit = self.blocked(mask, held, origin, direction, t_max, &Skips::Lanes { spheres, planes }).bits();
+            for (i, out) in out.iter_mut().enumerate() {
+                *out = hit & 1 << i != 0;
+            }
+        }
+    }
+}
+
+/// What shadow rays need not test (`Occluders::blocks_shadow`): the sphere
+/// a light sample lies on, and the light plane of the triangle it lies on.
+enum Skips {
+    /// The same for every lane (path tracing toward a scene's one light).
+    All {
+        sphere: Option<u32>,
+        plane: Option<u32>,
+    },
+    Lanes {
+        spheres: [Option<u32>; LANES],
+        planes: [Option<u32>; LANES],
+    },
 }
 
 /// Without lanes (a CPU without AVX2): the scalar tracer, sample by sample.

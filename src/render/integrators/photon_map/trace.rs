@@ -65,10 +65,12 @@ pub fn trace_photons_until(
 fn trace_chunk(path_lanes: Option<&PathLanes>, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
     // Each stored photon, and its photon's place among `indices`
     let (mut stored, mut places) = (Vec::new(), Vec::new());
-    let bounce = |place, flight: &mut Flight, hit: &Hit| {
-        tracing.bounce(flight, hit, &mut |photon| {
-            stored.push(photon);
-            places.push(place);
+    let bounce = |place, flight: &mut Flight, hit: Option<&Hit>| {
+        hit.is_some_and(|hit| {
+            tracing.bounce(flight, hit, &mut |photon| {
+                stored.push(photon);
+                places.push(place);
+            })
         })
     };
     let ray = |flight: &Flight| (flight.ray, flight.held);
