@@ -1,5 +1,6 @@
-//! Engine speed: ray–sphere intersections per second, and path-traced
-//! samples per second on every preset at 512×384 (run with `cargo bench`).
+//! Engine speed: ray–sphere intersections per second, shadow rays one and
+//! eight at a time, and path-traced samples per second on every preset at
+//! 512×384 (run with `cargo bench`).
 
 use std::hint::black_box;
 use std::sync::Arc;
@@ -104,5 +105,62 @@ fn sppm_caustics(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, ray_sphere, path_presets, whitted_cornell, sppm_caustics);
+/// The shadow rays of random paths through gap-room (its partition's six
+/// triangles), the Cornell box and smallpt: toward a sample of each light
+/// and between the path's vertices, as the bidirectional methods trace
+/// them. One at a time (`World::blocked`) and eight at a time
+/// (`PathLanes::shadows_blocked`).
+fn shadow_rays(c: &mut Criterion) {
+    use gi_studio::render::integrators::path_lanes::PathLanes;
+    use gi_studio::render::world::camera::{CameraModel, CameraTile, TileRect};
+    use gi_studio::render::world::occluders::Shadow;
+    use gi_studio::render::world::rng::PassStreams;
+    use gi_studio::render::world::World;
+    let mut group = c.benchmark_group("shadow_rays");
+    for name in ["gap-room", "cornell", "smallpt"] {
+        let scene = presets::preset(name).and_then(Result::ok).expect("a preset");
+        let camera = CameraModel::new(&scene.camera, 64, 48);
+        let (world, _) = World::for_view(&scene, &camera, 64, 48);
+        let lanes = PathLanes::new(&world).expect("a world the lanes trace");
+        let rect = TileRect { x: 0, y: 0, width: 64, height: 48 };
+        let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(0, 9) };
+        let mut s = Sampler::new(0, 0, 9);
+        let mut shadows = Vec::new();
+        for i in 0..rect.pixels() {
+            let mut ray = tile.sample(i).0;
+            let held = world.holds(ray.origin);
+            let mut vertices = Vec::new();
+            for _ in 0..4 {
+                let Some(hit) = world.intersect_held(&ray, f32::INFINITY, held) else { break };
+                for light in &world.lights {
+                    shadows.extend(light.sample(&hit.surface, s.next_2d()).map(|l| Shadow::toward(&l, held)));
+                }
+                for earlier in &vertices {
+                    let (segment, t_max) = hit.surface.spawn_ray_to(*earlier, 0.0);
+                    shadows.push(Shadow::segment(segment, t_max, held));
+                }
+                vertices.push(hit.surface.point);
+                let mut direction = uniform_sphere(s.next_2d());
+                if direction.dot(hit.surface.normal) * (-ray.direction).dot(hit.surface.normal) < 0.0 {
+                    direction = -direction;
+                }
+                ray = hit.surface.spawn_ray(direction);
+            }
+        }
+        group.throughput(Throughput::Elements(shadows.len() as u64));
+        group.bench_function(format!("{name}/one_at_a_time"), |b| {
+            b.iter(|| shadows.iter().filter(|shadow| world.blocked(black_box(shadow))).count())
+        });
+        let mut blocked = vec![false; shadows.len()];
+        group.bench_function(format!("{name}/eight_at_a_time"), |b| {
+            b.iter(|| {
+                lanes.shadows_blocked(&world, black_box(&shadows), &mut blocked);
+                blocked.iter().filter(|&&b| b).count()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, ray_sphere, shadow_rays, path_presets, whitted_cornell, sppm_caustics);
 criterion_main!(benches);
