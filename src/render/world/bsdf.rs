@@ -252,14 +252,26 @@ impl Bsdf {
     }
 
     /// `eval` and `pdf` together: a glossy lobe's power serves both.
-    #[inline]
+    /// Lambert's inline wherever it is asked (the bidirectional methods ask
+    /// four times a connection: a call passed its vectors through memory),
+    /// the glossy lobes out of line.
+    #[inline(always)]
     pub fn eval_pdf(&self, wo: Vec3, wi: Vec3, n: Vec3) -> (Rgb, f32) {
         if wi.dot(n) <= 0.0 || wo.dot(n) <= 0.0 {
             return (Rgb::ZERO, 0.0);
         }
+        match *self {
+            Bsdf::Lambert { albedo } => (albedo * FRAC_1_PI, cosine_hemisphere_pdf_of(V3::dot(wi.into(), n.into()))),
+            Bsdf::Phong { .. } | Bsdf::BlinnPhong { .. } => self.glossy_eval_pdf(wo, wi, n),
+            Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::Black => (Rgb::ZERO, 0.0),
+        }
+    }
+
+    /// `eval_pdf` of the glossy lobes, with both directions above the surface.
+    #[inline(never)]
+    fn glossy_eval_pdf(&self, wo: Vec3, wi: Vec3, n: Vec3) -> (Rgb, f32) {
         let (wo, wi, n) = (wo.into(), wi.into(), n.into());
         let (f, pdf) = match *self {
-            Bsdf::Lambert { albedo } => return (albedo * FRAC_1_PI, cosine_hemisphere_pdf_of(V3::dot(wi, n))),
             Bsdf::Phong { kd, ks, exponent } => {
                 phong_of(kd.into(), ks.into(), exponent, Self::diffuse_probability(kd, ks), wo, wi, n)
             }
@@ -267,7 +279,7 @@ impl Bsdf {
                 let (normalisation, pd) = (blinn_normalisation(exponent), Self::diffuse_probability(kd, ks));
                 blinn_phong_of(kd.into(), ks.into(), exponent, normalisation, pd, wo, wi, n)
             }
-            Bsdf::Mirror { .. } | Bsdf::Glass { .. } | Bsdf::Black => return (Rgb::ZERO, 0.0),
+            _ => return (Rgb::ZERO, 0.0),
         };
         (f.into(), pdf)
     }
