@@ -187,7 +187,7 @@ impl Integrator {
     ) -> Option<Self> {
         let settings = stage.settings;
         Some(match &settings.method {
-            Method::Whitted => Integrator::Whitted(whitted::Whitted { max_depth: settings.max_depth.max(1) }),
+            Method::Whitted => Integrator::Whitted(whitted::Whitted::new(stage.world, settings.max_depth.max(1))),
             Method::Path => Integrator::Path(path::PathTracer::new(stage.world, settings.max_depth)),
             Method::Photon(photon) => {
                 let maps = match maps {

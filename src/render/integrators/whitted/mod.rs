@@ -1,0 +1,91 @@
+//! Whitted ray tracing with the thesis' local models: per light a shadow ray
+//! and `kd·Ld·(l·n) + ks·Ls·(r·v)^α` (or `(n·h)^α`), plus `ka·La`; mirrors,
+//! Phong highlights' reflectivity and glass by recursion up to a depth limit.
+//!
+//! The thesis' light colour `Ld` is taken as the light's irradiance over π,
+//! so a Lambert surface gets exactly the physical direct term ρ/π·E·cos θ and
+//! Whitted images sit beside path-traced ones at the same brightness.
+//!
+//! A pixel's rays, by recursion here (`radiance`); a tile's, wave by wave
+//! with their rays and shadow rays eight at a time (`waves`), the same
+//! light bit for bit.
+
+mod shading;
+mod waves;
+
+use super::next_event::PathScope;
+use super::path_lanes::PathLanes;
+use super::Stage;
+use crate::geometry::Ray;
+use crate::render::integrators::Counters;
+use crate::render::world::camera::CameraTile;
+use crate::render::world::light::LightSource;
+use crate::render::world::rng::Sampler;
+use crate::render::world::World;
+use crate::scene::Rgb;
+use shading::{branches, combine, light_term, lit_cosine, shades};
+
+/// Whitted ray tracing, recursing at most `max_depth` times.
+pub struct Whitted {
+    pub max_depth: u32,
+    /// The world for eight rays at a time, where it can be compiled.
+    lanes: Option<Box<PathLanes>>,
+}
+
+impl Whitted {
+    pub fn new(world: &World, max_depth: u32) -> Self {
+        Self { max_depth, lanes: PathLanes::new(world).map(Box::new) }
+    }
+
+    #[inline]
+    pub fn radiance(&self, world: &World, ray: &Ray, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
+        radiance(world, ray, self.max_depth, sampler, counters)
+    }
+
+    /// One sample of every pixel of `tile`, into `out`.
+    pub fn render_tile(&self, stage: &Stage, tile: &CameraTile, out: &mut [Rgb], counters: &mut Counters) {
+        waves::render_tile(stage.world, self.lanes.as_deref(), tile, self.max_depth, out, counters);
+    }
+}
+
+/// Radiance along a camera ray, recursing at most `max_depth` times.
+pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
+    trace(PathScope::new(world, ray.origin), ray, max_depth, 1.0, sampler, counters)
+}
+
+/// The recursion, for a path seen as `scope` sees it; `weight` is what its
+/// result is multiplied by on the way to the camera.
+fn trace(
+    scope: PathScope,
+    ray: &Ray,
+    depth_left: u32,
+    weight: f32,
+    sampler: &mut Sampler,
+    counters: &mut Counters,
+) -> Rgb {
+    let world = scope.world;
+    counters.rays += 1;
+    let Some(hit) = scope.intersect(ray) else {
+        return world.background;
+    };
+    let material = world.material_of(&hit);
+    let mut local = Rgb::ZERO;
+    if shades(material) {
+        let (n, wo) = shading::facing(ray, &hit);
+        // The background is seen by rays that escape, not as a local light
+        for light in world.lights.iter().filter(|l| !matches!(l, LightSource::Background { .. })) {
+            let lit = |sample: &_| lit_cosine(n, sample);
+            if let Some((sample, cos)) = scope.light_sample(light, &hit, sampler.next_2d(), counters, lit) {
+                local += light_term(material, n, wo, &sample, cos);
+            }
+        }
+    }
+    let branches = branches(world, ray, &hit, depth_left, weight);
+    let mut follow = |branch: Option<(Ray, f32)>| match branch {
+        Some((ray, w)) => trace(scope, &ray, depth_left - 1, w, sampler, counters),
+        None => Rgb::ZERO,
+    };
+    let reflected = follow(branches.reflected);
+    let refracted = follow(branches.refracted);
+    combine(world, ray, &hit, depth_left, local, [reflected, refracted], &branches)
+}
