@@ -201,9 +201,9 @@ impl Integrator {
                         &|| observer.is_current(),
                     )?),
                 };
-                Integrator::Photon(photon::PhotonMapping::new(maps, photon, settings.max_depth))
+                Integrator::Photon(photon::PhotonMapping::new(stage.world, maps, photon, settings.max_depth))
             }
-            Method::Sppm(sppm) => Integrator::Sppm(sppm::Sppm::new(film, sppm, settings, visible_radius)),
+            Method::Sppm(sppm) => Integrator::Sppm(sppm::Sppm::new(stage.world, film, sppm, settings, visible_radius)),
             Method::LightTracing | Method::Bdpt(_) | Method::Bpm(_) | Method::Vcm(_) => {
                 Integrator::Bidir(bidir::Bidir::new(stage.world, settings, visible_radius))
             }

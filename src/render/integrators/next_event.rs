@@ -6,11 +6,12 @@
 
 use glam::{Vec2, Vec3};
 
+use super::shadow_batch::ShadowBatch;
 use super::Counters;
 use crate::geometry::Ray;
 use crate::render::world::bsdf::Bsdf;
 use crate::render::world::light::{LightSample, LightSource};
-use crate::render::world::occluders::Occluders;
+use crate::render::world::occluders::{Occluders, Shadow};
 use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::power_heuristic;
 use crate::render::world::{Hit, World};
@@ -127,11 +128,65 @@ impl<'w> PathScope<'w> {
     ) -> Rgb {
         let mut radiance = Rgb::ZERO;
         for light in &self.world.lights {
-            let shade = |sample: &LightSample| Some(bsdf.eval(wo, sample.wi, facing)).filter(|f| *f != Rgb::ZERO);
-            if let Some((sample, f)) = self.light_sample(light, hit, sampler.next_2d(), counters, shade) {
-                radiance += f * sample.value * sample.wi.dot(facing);
+            if let Some((sample, term)) = self.lit_term(light, hit, wo, facing, bsdf, sampler.next_2d(), counters) {
+                if !self.occluders.blocks(&sample) {
+                    radiance += term;
+                }
             }
         }
         radiance
     }
+
+    /// `every_light` with its shadow rays asked of `shadows`: each light's
+    /// term and its ray, into `terms`, for `lit_sum` once they are traced.
+    #[allow(clippy::too_many_arguments)]
+    pub fn every_light_later(
+        &self,
+        hit: &Hit,
+        wo: Vec3,
+        facing: Vec3,
+        bsdf: &Bsdf,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        shadows: &mut ShadowBatch,
+        terms: &mut Vec<(Rgb, u32)>,
+    ) {
+        for light in &self.world.lights {
+            if let Some((sample, term)) = self.lit_term(light, hit, wo, facing, bsdf, sampler.next_2d(), counters) {
+                terms.push((term, shadows.push(Shadow::toward(&sample, self.held))));
+            }
+        }
+    }
+
+    /// One light's unweighted term, f·L·cos, where it can matter; its
+    /// shadow ray is counted, not traced.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn lit_term(
+        &self,
+        light: &LightSource,
+        hit: &Hit,
+        wo: Vec3,
+        facing: Vec3,
+        bsdf: &Bsdf,
+        u: Vec2,
+        counters: &mut Counters,
+    ) -> Option<(LightSample, Rgb)> {
+        let shade = |sample: &LightSample| Some(bsdf.eval(wo, sample.wi, facing)).filter(|f| *f != Rgb::ZERO);
+        let (sample, f) = self.unshadowed_light_sample(light, hit, u, counters, shade)?;
+        let term = f * sample.value * sample.wi.dot(facing);
+        Some((sample, term))
+    }
+}
+
+/// The direct light of `every_light_later`'s terms, in order, those that
+/// `shadows` (traced) lets through: `every_light`, bit for bit.
+pub fn lit_sum(terms: &[(Rgb, u32)], shadows: &ShadowBatch) -> Rgb {
+    let mut radiance = Rgb::ZERO;
+    for &(term, shadow) in terms {
+        if !shadows.blocked(shadow) {
+            radiance += term;
+        }
+    }
+    radiance
 }

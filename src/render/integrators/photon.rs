@@ -7,10 +7,13 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
+use super::next_event::lit_sum;
 use super::next_event::PathScope;
+use super::path_lanes::PathLanes;
 use super::photon_map::kdtree::Neighbours;
 use super::photon_map::maps::{estimate, PhotonMaps, QueryStats};
-use super::specular::{follow_specular, Emission, Landing};
+use super::shadow_batch::ShadowBatch;
+use super::specular::{follow_specular, follow_specular_tile, Emission, Landing};
 use super::{Counters, Stage};
 use crate::geometry::Ray;
 use crate::render::settings::PhotonSettings;
@@ -40,11 +43,14 @@ pub struct PhotonMapping {
     pub maps: Arc<PhotonMaps>,
     settings: PhotonSettings,
     max_depth: u32,
+    /// The world for eight rays at a time, where it can be compiled: the
+    /// camera rays and the shadow rays of their landings.
+    lanes: Option<Box<PathLanes>>,
 }
 
 impl PhotonMapping {
-    pub fn new(maps: Arc<PhotonMaps>, settings: &PhotonSettings, max_depth: u32) -> Self {
-        Self { maps, settings: settings.clone(), max_depth }
+    pub fn new(world: &World, maps: Arc<PhotonMaps>, settings: &PhotonSettings, max_depth: u32) -> Self {
+        Self { maps, settings: settings.clone(), max_depth, lanes: PathLanes::new(world).map(Box::new) }
     }
 
     pub fn scratch(&self) -> PhotonScratch {
@@ -60,23 +66,47 @@ impl PhotonMapping {
         counters: &mut Counters,
         scratch: &mut PhotonScratch,
     ) -> Rgb {
-        let renderer = PhotonRenderer {
-            scope: PathScope::new(world, ray.origin),
-            maps: &self.maps,
-            settings: &self.settings,
-            max_depth: self.max_depth,
-        };
-        renderer.radiance(ray, sampler, counters, scratch)
+        self.renderer(PathScope::new(world, ray.origin)).radiance(ray, sampler, counters, scratch)
     }
 
-    /// One sample of every pixel of `tile`, into `out`.
+    /// One sample of every pixel of `tile`, into `out`: `radiance` of each,
+    /// bit for bit, the camera rays eight at a time and the shadow rays of
+    /// every landing's direct light traced together.
     pub fn render_tile(&self, stage: &Stage, tile: &CameraTile, out: &mut [Rgb], counters: &mut Counters) {
+        let (world, lanes) = (stage.world, self.lanes.as_deref());
         let mut scratch = self.scratch();
-        for (i, value) in out.iter_mut().enumerate() {
-            let (ray, mut sampler) = tile.sample(i);
-            *value = self.radiance(stage.world, &ray, &mut sampler, counters, &mut scratch);
+        let (mut shadows, mut terms) = (ShadowBatch::default(), Vec::new());
+        // Each sample's light on the way, and at its landing the throughput,
+        // the direct light's terms and the estimates added after them
+        let mut found = vec![(Rgb::ZERO, None); out.len()];
+        let land = |i: usize, scope: &PathScope, sampler: &mut Sampler, radiance, landing, counters: &mut Counters| {
+            let Some(Landing { hit, wo, bsdf, throughput }) = landing else {
+                found[i] = (radiance, None);
+                return;
+            };
+            let renderer = self.renderer(*scope);
+            let first = terms.len();
+            let (caustic, second) =
+                renderer.shade_later(&hit, wo, &bsdf, sampler, counters, &mut scratch, (&mut shadows, &mut terms));
+            found[i] = (radiance, Some((throughput, first..terms.len(), caustic, second)));
+        };
+        follow_specular_tile(world, lanes, tile, self.max_depth, counters, land);
+        shadows.trace(lanes, world);
+        for (value, (radiance, landed)) in out.iter_mut().zip(found) {
+            *value = match landed {
+                Some((throughput, lit, caustic, second)) => {
+                    let mut shade = lit_sum(&terms[lit], &shadows) + caustic;
+                    shade += second;
+                    radiance + throughput * shade
+                }
+                None => radiance,
+            };
         }
         counters.queries.add(&scratch.queries);
+    }
+
+    fn renderer<'a>(&'a self, scope: PathScope<'a>) -> PhotonRenderer<'a> {
+        PhotonRenderer { scope, maps: &self.maps, settings: &self.settings, max_depth: self.max_depth }
     }
 }
 
@@ -105,6 +135,32 @@ impl PhotonRenderer<'_> {
         radiance + throughput * self.shade(&hit, wo, &bsdf, self.settings.final_gather, sampler, counters, scratch)
     }
 
+    /// `shade` of a camera path's landing with its direct light's shadow
+    /// rays asked of `later` (its terms pushed there): the caustic
+    /// estimate, then what `shade` adds to it, the global map's estimate or
+    /// the final gather's.
+    #[allow(clippy::too_many_arguments)]
+    fn shade_later(
+        &self,
+        hit: &Hit,
+        wo: Vec3,
+        bsdf: &Bsdf,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        scratch: &mut PhotonScratch,
+        (shadows, terms): (&mut ShadowBatch, &mut Vec<(Rgb, u32)>),
+    ) -> (Rgb, Rgb) {
+        let n = hit.surface.normal;
+        let facing = if wo.dot(n) < 0.0 { -n } else { n };
+        self.scope.every_light_later(hit, wo, facing, bsdf, sampler, counters, shadows, terms);
+        let caustic = self.caustic(hit, wo, facing, bsdf, scratch);
+        let second = match self.settings.final_gather {
+            false => self.global(hit, wo, facing, bsdf, scratch),
+            true => self.final_gather(hit, wo, bsdf, sampler, counters, scratch),
+        };
+        (caustic, second)
+    }
+
     /// Outgoing radiance at a non-specular hit, emission excluded.
     #[allow(clippy::too_many_arguments)]
     fn shade(
@@ -121,17 +177,31 @@ impl PhotonRenderer<'_> {
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
         let mut radiance = self.radiance_from_maps(hit, wo, facing, bsdf, !gather, sampler, counters, scratch);
         if gather {
-            let rays = self.settings.final_gather_rays.max(1);
-            let mut sum = Rgb::ZERO;
-            for _ in 0..rays {
-                let Some(s) = bsdf.sample(wo, n, sampler, Transport::Radiance) else {
-                    continue;
-                };
-                sum += s.weight * self.gathered(hit.surface.spawn_ray(s.wi), sampler, counters, scratch);
-            }
-            radiance += sum / rays as f32;
+            radiance += self.final_gather(hit, wo, bsdf, sampler, counters, scratch);
         }
         radiance
+    }
+
+    /// Indirect light at a non-specular hit by a final gather: the maps'
+    /// estimates where its rays land, averaged.
+    fn final_gather(
+        &self,
+        hit: &Hit,
+        wo: Vec3,
+        bsdf: &Bsdf,
+        sampler: &mut Sampler,
+        counters: &mut Counters,
+        scratch: &mut PhotonScratch,
+    ) -> Rgb {
+        let rays = self.settings.final_gather_rays.max(1);
+        let mut sum = Rgb::ZERO;
+        for _ in 0..rays {
+            let Some(s) = bsdf.sample(wo, hit.surface.normal, sampler, Transport::Radiance) else {
+                continue;
+            };
+            sum += s.weight * self.gathered(hit.surface.spawn_ray(s.wi), sampler, counters, scratch);
+        }
+        sum / rays as f32
     }
 
     /// Radiance arriving along a final-gather ray: the maps' full estimate at
@@ -163,23 +233,93 @@ impl PhotonRenderer<'_> {
         counters: &mut Counters,
         scratch: &mut PhotonScratch,
     ) -> Rgb {
-        let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
         let mut radiance = self.scope.every_light(hit, wo, facing, bsdf, sampler, counters);
-        radiance +=
-            estimate(&self.maps.caustic, point, facing, wo, bsdf, k, r, &mut scratch.neighbours, &mut scratch.queries);
+        radiance += self.caustic(hit, wo, facing, bsdf, scratch);
         if global {
-            radiance += estimate(
-                &self.maps.global,
-                point,
-                facing,
-                wo,
-                bsdf,
-                k,
-                r,
-                &mut scratch.neighbours,
-                &mut scratch.queries,
-            );
+            radiance += self.global(hit, wo, facing, bsdf, scratch);
         }
         radiance
+    }
+
+    /// The caustic map's estimate at `hit`.
+    fn caustic(&self, hit: &Hit, wo: Vec3, facing: Vec3, bsdf: &Bsdf, scratch: &mut PhotonScratch) -> Rgb {
+        let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
+        let PhotonScratch { neighbours, queries } = scratch;
+        estimate(&self.maps.caustic, point, facing, wo, bsdf, k, r, neighbours, queries)
+    }
+
+    /// The global map's estimate at `hit`.
+    fn global(&self, hit: &Hit, wo: Vec3, facing: Vec3, bsdf: &Bsdf, scratch: &mut PhotonScratch) -> Rgb {
+        let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
+        let PhotonScratch { neighbours, queries } = scratch;
+        estimate(&self.maps.global, point, facing, wo, bsdf, k, r, neighbours, queries)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::settings::RenderSettings;
+    use crate::render::world::camera::{CameraModel, TileRect};
+    use crate::render::world::rng::PassStreams;
+    use crate::scene::presets;
+
+    /// Every preset, reading the global map directly and through a final
+    /// gather: a tile rendered with its camera rays eight at a time (or one)
+    /// and its landings' shadow rays traced together is `radiance` sample by
+    /// sample — the same light, rays and queries, bit for bit.
+    #[test]
+    fn a_tile_is_radiance_sample_by_sample() {
+        for name in presets::names() {
+            let scene = presets::preset(name).and_then(Result::ok).expect("preset");
+            let (width, height) = (32, 24);
+            let camera = CameraModel::new(&scene.camera, width, height);
+            let (world, visible_radius) = World::for_view(&scene, &camera, width, height);
+            for final_gather in [false, true] {
+                let settings = PhotonSettings {
+                    global_photons: 4000,
+                    caustic_photons: 4000,
+                    k_nearest: 20,
+                    final_gather,
+                    final_gather_rays: 3,
+                    ..PhotonSettings::default()
+                };
+                let maps = PhotonMaps::build_until(&world, &settings, 3, 8, visible_radius, &|| true).expect("maps");
+                let photon = PhotonMapping::new(&world, Arc::new(maps), &settings, 8);
+                let rect = TileRect { x: 3, y: 2, width: 21, height: 9 };
+                let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(2, 9) };
+                let (mut expected_counters, mut scratch) = (Counters::default(), photon.scratch());
+                let expected: Vec<[u32; 3]> = (0..tile.len())
+                    .map(|i| {
+                        let (ray, mut sampler) = tile.sample(i);
+                        let value = photon.radiance(&world, &ray, &mut sampler, &mut expected_counters, &mut scratch);
+                        value.to_array().map(f32::to_bits)
+                    })
+                    .collect();
+                expected_counters.queries.add(&scratch.queries);
+                let settings = RenderSettings::default();
+                let stage = Stage { world: &world, camera: &camera, settings: &settings };
+                for lanes in [true, false] {
+                    let scalar = PhotonMapping {
+                        lanes: None,
+                        ..PhotonMapping::new(&world, photon.maps.clone(), &photon.settings, 8)
+                    };
+                    let renderer = if lanes { &photon } else { &scalar };
+                    let (mut out, mut counters) = (vec![Rgb::splat(-1.0); tile.len()], Counters::default());
+                    renderer.render_tile(&stage, &tile, &mut out, &mut counters);
+                    let got: Vec<[u32; 3]> = out.iter().map(|v| v.to_array().map(f32::to_bits)).collect();
+                    let what = format!("{name}, final gather {final_gather}, lanes {lanes}");
+                    assert!(got == expected, "{what}: the light differs");
+                    // Everything counted but the queries' time
+                    let counted = |c: &Counters| {
+                        let q = &c.queries;
+                        (c.rays, c.non_finite, q.queries, q.nodes_visited, q.radius_histogram)
+                    };
+                    assert_eq!(counted(&counters), counted(&expected_counters), "{what}");
+                }
+                let lit = expected.iter().filter(|v| v.iter().any(|&c| c != 0)).count();
+                assert!(lit > tile.len() / 4, "{name}: only {lit} samples lit");
+            }
+        }
     }
 }

@@ -12,10 +12,13 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::next_event::lit_sum;
 use super::next_event::PathScope;
+use super::path_lanes::PathLanes;
 use super::photon_map::grid::PhotonGrid;
 use super::photon_map::trace::{trace_photons_until, MapKind};
-use super::specular::{follow_specular, Emission, Landing};
+use super::shadow_batch::ShadowBatch;
+use super::specular::{follow_specular, follow_specular_tile, Emission, Landing};
 use super::{Counters, PassObserver, PassReport, SppmTimes, Stage};
 use crate::faults::{self, Fault};
 use crate::geometry::Ray;
@@ -36,11 +39,20 @@ pub struct Sppm {
     alpha: f32,
     max_depth: u32,
     seed: u64,
+    /// The world for eight rays at a time, where it can be compiled: the
+    /// eye pass's rays and shadow rays.
+    lanes: Option<Box<PathLanes>>,
 }
 
 impl Sppm {
     /// The starting radius is the settings', or 2% of what the camera sees.
-    pub fn new(film: &Film, sppm: &SppmSettings, settings: &RenderSettings, visible_radius: f32) -> Self {
+    pub fn new(
+        world: &World,
+        film: &Film,
+        sppm: &SppmSettings,
+        settings: &RenderSettings,
+        visible_radius: f32,
+    ) -> Self {
         let initial_radius =
             if sppm.initial_radius > 0.0 { sppm.initial_radius } else { (visible_radius * 0.02).max(1e-6) };
         Self {
@@ -50,6 +62,7 @@ impl Sppm {
             alpha: sppm.alpha,
             max_depth: settings.max_depth,
             seed: settings.seed,
+            lanes: PathLanes::new(world).map(Box::new),
         }
     }
 
@@ -75,7 +88,7 @@ impl Sppm {
     ) -> Option<PassReport> {
         let streams = stage.streams(pass as u64);
         let initial_radius = self.initial_radius;
-        let max_depth = self.max_depth;
+        let (max_depth, lanes) = (self.max_depth, self.lanes.as_deref());
         let mut report = PassReport::default();
         let eye_start = Instant::now();
         let per_tile: Vec<Counters> = (film.tiles.par_iter())
@@ -87,11 +100,11 @@ impl Sppm {
                     return counters;
                 }
                 let camera_tile = CameraTile { camera: stage.camera, rect: tile.rect, streams };
-                for (i, pixel) in pixels.iter_mut().enumerate() {
-                    let (ray, mut sampler) = camera_tile.sample(i);
-                    let (direct, visible) = camera_pass(stage.world, &ray, max_depth, &mut sampler, &mut counters);
-                    pixel.direct += stage.accept(direct, &mut counters).unwrap_or(Rgb::ZERO);
-                    pixel.visible = visible;
+                for (pixel, direct) in
+                    pixels.iter_mut().zip(eye_pass(stage.world, lanes, &camera_tile, max_depth, &mut counters))
+                {
+                    pixel.direct += stage.accept(direct.0, &mut counters).unwrap_or(Rgb::ZERO);
+                    pixel.visible = direct.1;
                     if pixel.radius == 0.0 {
                         pixel.radius = initial_radius;
                     }
@@ -248,10 +261,88 @@ pub fn camera_pass(
     (radiance, Some(visible))
 }
 
+/// `camera_pass` of every camera sample of `tile`: the rays eight at a
+/// time through `lanes` where given, the shadow rays of every visible
+/// point's direct light traced together; the same light bit for bit.
+pub fn eye_pass(
+    world: &World,
+    lanes: Option<&PathLanes>,
+    tile: &CameraTile,
+    max_depth: u32,
+    counters: &mut Counters,
+) -> Vec<(Rgb, Option<VisiblePoint>)> {
+    let (mut shadows, mut terms) = (ShadowBatch::default(), Vec::new());
+    // Each sample's light on the way, its visible point and its direct light's terms
+    let mut found = vec![(Rgb::ZERO, None, 0..0); tile.len()];
+    follow_specular_tile(world, lanes, tile, max_depth, counters, |i, scope, sampler, radiance, landing, counters| {
+        let Some(Landing { hit, wo, bsdf, throughput }) = landing else {
+            found[i] = (radiance, None, 0..0);
+            return;
+        };
+        let n = hit.surface.normal;
+        let facing = if wo.dot(n) < 0.0 { -n } else { n };
+        let first = terms.len();
+        scope.every_light_later(&hit, wo, facing, &bsdf, sampler, counters, &mut shadows, &mut terms);
+        let visible = VisiblePoint { point: hit.surface.point, facing, wo, bsdf, throughput };
+        found[i] = (radiance, Some(visible), first..terms.len());
+    });
+    shadows.trace(lanes, world);
+    (found.into_iter())
+        .map(|(radiance, visible, lit)| match visible {
+            Some(v) => (radiance + v.throughput * lit_sum(&terms[lit], &shadows), Some(v)),
+            None => (radiance, None),
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::render::integrators::photon_map::Photon;
+    use crate::render::world::camera::{CameraModel, TileRect};
+    use crate::render::world::rng::PassStreams;
+    use crate::scene::presets;
+
+    /// Every preset, at depth caps of one, two and eight: a tile's eye
+    /// pass, its rays eight at a time or one, finds what `camera_pass`
+    /// finds sample by sample — the same light, visible points and rays
+    /// counted, bit for bit.
+    #[test]
+    fn a_tiles_eye_pass_is_camera_pass_sample_by_sample() {
+        for name in presets::names() {
+            let scene = presets::preset(name).and_then(Result::ok).expect("preset");
+            let (width, height) = (40, 30);
+            let camera = CameraModel::new(&scene.camera, width, height);
+            let (world, _) = World::for_view(&scene, &camera, width, height);
+            let lanes = PathLanes::new(&world);
+            let rect = TileRect { x: 3, y: 2, width: 29, height: 11 };
+            let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(1, 4) };
+            for max_depth in [1, 2, 8] {
+                let mut expected_counters = Counters::default();
+                let expected: Vec<String> = (0..tile.len())
+                    .map(|i| {
+                        let (ray, mut sampler) = tile.sample(i);
+                        let found = camera_pass(&world, &ray, max_depth, &mut sampler, &mut expected_counters);
+                        format!("{:?} {:?}", found.0.to_array().map(f32::to_bits), found.1)
+                    })
+                    .collect();
+                for lanes in [lanes.as_ref(), None] {
+                    let mut counters = Counters::default();
+                    let got: Vec<String> = (eye_pass(&world, lanes, &tile, max_depth, &mut counters).iter())
+                        .map(|found| format!("{:?} {:?}", found.0.to_array().map(f32::to_bits), found.1))
+                        .collect();
+                    assert!(
+                        got == expected,
+                        "{name}, depth {max_depth}, lanes {}: the eye pass differs",
+                        lanes.is_some()
+                    );
+                    assert_eq!(counters.rays, expected_counters.rays, "{name}, depth {max_depth}");
+                }
+                let visible = expected.iter().filter(|e| e.contains("Some")).count();
+                assert!(visible > tile.len() / 5, "{name}: only {visible} visible points");
+            }
+        }
+    }
 
     #[test]
     fn radius_shrinks_stays_positive_and_finite_over_thousands_of_passes() {
