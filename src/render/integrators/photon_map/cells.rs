@@ -133,6 +133,17 @@ impl PointGrid {
         let (px, py, pz) = (F8::splat(point.x), F8::splat(point.y), F8::splat(point.z));
         let bound = F8::splat(bound);
         let lane = F8::from_array([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+        // Every bucket's first points asked for at once, not one bucket's
+        // after another's (a merge's few buckets each miss the cache: BPM
+        // and VCM on gap-room at 256×192 took 0.976 and 0.967 of the time)
+        if let Touched::Few(ids, len) = touched {
+            for &b in &ids[..*len] {
+                let start = self.starts[b as usize] as usize;
+                prefetch(&self.position[0][start]);
+                prefetch(&self.position[1][start]);
+                prefetch(&self.position[2][start]);
+            }
+        }
         for (start, end) in self.ranges(touched) {
             for i in (start..end).step_by(LANES) {
                 // No closures here: they would be compiled without AVX2
