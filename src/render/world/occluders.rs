@@ -276,13 +276,6 @@ impl<'w> Occluders<'w> {
         Occluders { spheres, planes, triangles, triangle_lanes, light_plane }
     }
 
-    /// Whether anything lies on `ray` before `t_max` (a connection of two
-    /// path vertices, or of one to the camera).
-    #[inline]
-    pub fn segment_blocked(&self, ray: &Ray, t_max: f32) -> bool {
-        self.blocks_shadow(&Shadow::segment(*ray, t_max, false))
-    }
-
     /// Whether anything lies between the shading point and the light sample.
     #[inline]
     pub fn blocks(&self, sample: &LightSample) -> bool {

@@ -113,11 +113,19 @@ impl Found {
 
 /// Paths that ended, waiting for their shadow rays, which are traced
 /// together once there are `WAITING` of them (a few batches of eight) or
-/// as many paths: each path's place, small pixel, what it found, and where
-/// its shadow rays start in `shadows`.
+/// as many paths.
 struct Ended {
-    paths: Vec<(u32, u32, Found, u32)>,
+    paths: Vec<EndedPath>,
     shadows: ShadowBatch,
+}
+
+/// A path that ended: its place in the tile, its small pixel, what it
+/// found, and where its shadow rays start in `Ended::shadows`.
+struct EndedPath {
+    place: u32,
+    small_pixel: u32,
+    found: Found,
+    first: u32,
 }
 
 const WAITING: usize = 32;
@@ -185,7 +193,7 @@ pub fn trace(
     // The ended paths' shadow rays traced, their light into `out`
     let mut finish = |ended: &mut Ended, contributions: &mut Vec<Contribution>| {
         ended.shadows.trace(ctx.path_lanes, ctx.world);
-        for (place, small_pixel, mut found, first) in ended.paths.drain(..) {
+        for EndedPath { place, small_pixel, mut found, first } in ended.paths.drain(..) {
             out[place as usize] = match ctx.strategy_film {
                 Some(_) => found.sum(&ended.shadows, first, &mut PixelTally { pixel: small_pixel, out: contributions }),
                 None => found.sum(&ended.shadows, first, &mut NoTally),
@@ -201,7 +209,7 @@ pub fn trace(
         }
         let mut found = std::mem::take(&mut path.found);
         let first = ended.shadows.append(&mut found.shadows);
-        ended.paths.push((place, path.small_pixel, found, first));
+        ended.paths.push(EndedPath { place, small_pixel: path.small_pixel, found, first });
         if ended.shadows.count() as usize >= WAITING || ended.paths.len() >= WAITING {
             finish(&mut ended, contributions);
         }

@@ -754,7 +754,6 @@ impl PathLanes {
     /// blocked; paths inside every wall skip the walls, and each ray what
     /// `skips` says it ends on (`Occluders::blocks_shadow`).
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     fn blocked(&self, mask: M8, inside_walls: M8, origin: V8, direction: V8, t_max: F8, skips: &Skips) -> M8 {
         let mut blocked = M8::NONE;
         // Plain loops: a closure here would not inherit AVX2
