@@ -2,6 +2,7 @@
 //! cases: huge spheres used as walls, rays from far away, grazing and tangent
 //! rays, rays spawned on surfaces. Nothing here knows about materials or light.
 
+mod cull;
 mod frame;
 mod plane;
 pub mod pow;
@@ -10,6 +11,7 @@ pub mod real;
 pub mod sphere;
 mod triangle;
 
+pub use cull::{Crossing, CullPlane, TriangleCull};
 pub use frame::{frame_from_z, to_world, Frame};
 pub use plane::intersect_plane;
 pub(crate) use plane::{plane_exit_of, plane_exit_t, plane_hit, plane_point_of, plane_t, plane_t_of};
@@ -19,7 +21,7 @@ pub(crate) use sphere::sphere_hit;
 pub use sphere::sphere_t;
 #[cfg(test)]
 pub(crate) use triangle::shear_of;
-pub(crate) use triangle::{edges_of, may_reach_of, ray_shear_of, triangle_hit_of, RayShear};
+pub(crate) use triangle::{edges_of, ray_shear_of, triangle_hit_of, RayShear};
 pub use triangle::{intersect_triangle, Triangle};
 pub(crate) use triangle::{watertight_finish_of, watertight_range_of};
 

@@ -1,5 +1,6 @@
 use glam::{DVec3, Vec3};
 
+use super::cull::{Crossing, TriangleCull};
 use super::real::{Mask, Real, V3};
 use super::{gamma, Ray, SurfaceHit};
 
@@ -9,9 +10,9 @@ use super::{gamma, Ray, SurfaceHit};
 pub struct Triangle {
     pub vertices: [Vec3; 3],
     pub normal: Vec3,
-    /// A ball holding the triangle, for rejecting rays that pass far from it.
-    bound_center: Vec3,
-    bound_radius: f32,
+    /// Its plane and edges, for turning away rays that cross the plane
+    /// elsewhere (`cull`).
+    pub cull: TriangleCull,
     area: f32,
 }
 
@@ -23,10 +24,34 @@ impl Triangle {
         let length = n.length();
         let normal = if length > 0.0 && length.is_finite() { (n / length).as_vec3() } else { Vec3::ZERO };
         let area = (0.5 * length) as f32;
-        // The ball about the centroid, measured from the centre as rounded to f32
-        let bound_center = ((a64 + b64 + c64) / 3.0).as_vec3();
-        let reach = [a64, b64, c64].map(|v| (v - bound_center.as_dvec3()).length()).into_iter().fold(0.0, f64::max);
-        Self { vertices: [a, b, c], normal, bound_center, bound_radius: (reach as f32).next_up(), area }
+        let vertices = [a, b, c];
+        let scale = vertices.iter().map(|v| v.abs().max_element()).fold(0.0, f32::max);
+        let cull = TriangleCull::new(vertices, TriangleCull::plane_of(vertices, normal, scale));
+        Self { vertices, normal, cull, area }
+    }
+
+    /// Planes shared along runs of coplanar triangles: each triangle in
+    /// the plane of the first of its run (`holds_in_plane`), with the run's
+    /// scale, so that the lanes cross each run's plane once for all of it.
+    /// Runs, not groups: a scene's quads come as neighbours, and a run is
+    /// found in one pass however many triangles there are.
+    pub fn share_planes(triangles: &mut [&mut Triangle]) {
+        let mut start = 0;
+        while start < triangles.len() {
+            let leader = *triangles[start];
+            let mut end = start + 1;
+            while end < triangles.len() && !leader.is_degenerate() && leader.holds_in_plane(triangles[end]) {
+                end += 1;
+            }
+            let run = &mut triangles[start..end];
+            let vertices = run.iter().flat_map(|t| t.vertices);
+            let scale = vertices.map(|v| v.abs().max_element()).fold(0.0, f32::max);
+            let plane = TriangleCull::plane_of(leader.vertices, leader.normal, scale);
+            for triangle in run.iter_mut() {
+                triangle.cull = TriangleCull::new(triangle.vertices, plane);
+            }
+            start = end;
+        }
     }
 
     pub fn is_degenerate(&self) -> bool {
@@ -35,11 +60,6 @@ impl Triangle {
 
     pub fn area(&self) -> f32 {
         self.area
-    }
-
-    /// The ball holding it, as `may_reach` tests it: (centre, radius).
-    pub fn bound(&self) -> (Vec3, f32) {
-        (self.bound_center, self.bound_radius)
     }
 
     /// Whether `other` lies in this triangle's plane, to within rounding.
@@ -57,33 +77,18 @@ impl Triangle {
 /// Watertight ray–triangle intersection (Woop, Benthin, Wald 2013, as in
 /// pbrt-v4): shear the triangle into the ray's space so that rays through
 /// shared edges and vertices hit exactly one side or both, never neither.
+/// Rays that cross the plane away from the triangle are turned away first
+/// (`cull`).
 #[inline]
 pub fn intersect_triangle(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<SurfaceHit> {
-    if triangle.is_degenerate() || !may_reach(ray, triangle.bound_center, triangle.bound_radius, t_max) {
+    if triangle.is_degenerate() {
+        return None;
+    }
+    let crossing = Crossing::<f32>::of(ray.origin.into(), ray.direction.into(), &triangle.cull.plane);
+    if crossing.test(&triangle.cull.edges.splat(), t_max).0 {
         return None;
     }
     watertight(ray, triangle, t_max)
-}
-
-/// Whether `ray` may meet the ball (`center`, `radius`) within (0, t_max):
-/// a few multiplies that spare most rays the watertight test. The ball is
-/// grown by a bound on the rounding of the closest approach, so a ray the
-/// watertight test would hit is never turned away (and the mesh stays
-/// watertight).
-#[inline]
-fn may_reach(ray: &Ray, center: Vec3, radius: f32, t_max: f32) -> bool {
-    may_reach_of(V3::from(ray.origin), V3::from(ray.direction), V3::from(center), radius, t_max)
-}
-
-/// `may_reach` in any lanes (a triangle's ball against several rays).
-#[inline(always)]
-pub fn may_reach_of<R: Real>(origin: V3<R>, direction: V3<R>, center: V3<R>, radius: R, t_max: R) -> R::Mask {
-    let f = origin - center;
-    let b = f.dot(direction);
-    let closest = f - direction * b;
-    let reach = radius + R::splat(gamma(16)) * (f.abs().element_sum() + radius);
-    // Beside the ray, wholly behind its origin, or wholly beyond t_max
-    closest.length_squared().le(reach * reach).and(b.le(reach)).and((-b - reach).lt(t_max))
 }
 
 #[inline]
@@ -318,11 +323,14 @@ mod tests {
         assert!(intersect_triangle(&Ray::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::Z), &tri, 1.0).is_none());
     }
 
-    /// The ball in front of the watertight test never turns a hit into a
-    /// miss: triangles at scales 1e-6 … 1e6, from 1e-3 to 1e3 of their size
-    /// away, rays aimed at vertices, edge points and interiors.
+    /// The cull in front of the watertight test never turns a hit into a
+    /// miss: triangles at scales 1e-6 … 1e6, 100 of their sizes from the
+    /// origin, seen from 1e-3 to 1e3 of their size away, rays aimed at
+    /// vertices, edge points and interiors. It turns away rays sent the
+    /// other way, and rays that cross the plane beside an edge (those not
+    /// grazing it); a ray it calls sure, the watertight test hits.
     #[test]
-    fn bounding_ball_never_turns_away_a_hit() {
+    fn the_cull_never_turns_away_a_hit() {
         let mut state = 0x2545_f491_4f6c_dd1du64;
         let mut uniform = move || {
             state ^= state << 13;
@@ -330,7 +338,11 @@ mod tests {
             state ^= state << 17;
             (state >> 40) as f32 / (1u64 << 24) as f32
         };
-        let (mut hits, mut misses, mut turned_away) = (0, 0, 0);
+        let cull = |ray: &Ray, tri: &Triangle| {
+            let crossing = Crossing::<f32>::of(ray.origin.into(), ray.direction.into(), &tri.cull.plane);
+            crossing.test(&tri.cull.edges.splat(), f32::INFINITY)
+        };
+        let (mut hits, mut sure, mut away, mut away_turned, mut beside, mut beside_turned) = (0, 0, 0, 0, 0, 0);
         for case in 0..40_000 {
             let scale = 10f32.powf(uniform() * 12.0 - 6.0);
             let mut point = || Vec3::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5) * 2.0;
@@ -345,22 +357,68 @@ mod tests {
             };
             let origin = target + point().normalize() * scale * 10f32.powf(uniform() * 6.0 - 3.0);
             let ray = Ray::new(origin, (target - origin).normalize());
-            let reach = may_reach(&ray, tri.bound_center, tri.bound_radius, f32::INFINITY);
-            if watertight(&ray, &tri, f32::INFINITY).is_some() {
+            let (turned_away, surely) = cull(&ray, &tri);
+            let hit = watertight(&ray, &tri, f32::INFINITY).is_some();
+            if hit {
                 hits += 1;
-                assert!(reach, "case {case}: a hit turned away by the bound of {tri:?}, ray {ray:?}");
+                assert!(!turned_away, "case {case}: a hit turned away by the cull of {tri:?}, ray {ray:?}");
             }
-            // A ray sent the opposite way misses; from outside the ball, the
-            // ball should turn it away
-            let away = Ray::new(origin, -ray.direction);
-            let outside = (origin - tri.bound_center).length() > 2.0 * tri.bound_radius;
-            if outside && watertight(&away, &tri, f32::INFINITY).is_none() {
-                misses += 1;
-                turned_away += !may_reach(&away, tri.bound_center, tri.bound_radius, f32::INFINITY) as u32;
+            if surely {
+                sure += 1;
+                assert!(hit, "case {case}: sure of a ray the watertight test misses, {tri:?}, ray {ray:?}");
+            }
+            // Away from the triangle, for rays not grazing its plane from
+            // within a few sizes of it (further off, or grazing, the slack
+            // grows past the triangle's size)
+            let (distance, cos) = ((origin - target).length(), ray.direction.dot(tri.normal).abs());
+            if tri.is_degenerate() || distance < scale || distance > scale * 10.0 || cos < 0.2 {
+                continue;
+            }
+            // The opposite way: the plane lies behind the ray
+            let back = Ray::new(origin, -ray.direction);
+            away += 1;
+            away_turned += cull(&back, &tri).0 as u32;
+            // Beside edge ab, as far out as the triangle is wide there
+            let out = tri.normal.cross(b - a).normalize() * -(c - a).dot(tri.normal.cross(b - a).normalize());
+            let ray = Ray::new(origin, ((a + b) * 0.5 + out - origin).normalize());
+            if ray.direction.dot(tri.normal).abs() > 0.2 && out.length() > scale * 0.1 {
+                beside += 1;
+                beside_turned += cull(&ray, &tri).0 as u32;
             }
         }
-        assert!(hits > 20_000, "only {hits} hits");
-        assert!(misses > 10_000 && turned_away == misses, "{turned_away} of {misses} misses turned away");
+        assert!(hits > 20_000 && sure > 5_000, "{hits} hits, {sure} sure");
+        assert!(away > 5_000 && away_turned == away, "{away_turned} of {away} rays sent away turned away");
+        assert!(
+            beside > 3_000 && beside_turned == beside,
+            "{beside_turned} of {beside} rays beside an edge turned away"
+        );
+    }
+
+    /// Triangles in one plane share it, with the run's scale; the edges of
+    /// each are its own, and a triangle off the plane starts a run of its
+    /// own.
+    #[test]
+    fn runs_of_coplanar_triangles_share_a_plane() {
+        let quad =
+            [Vec3::new(1.0, 0.0, -3.0), Vec3::new(1.0, 0.0, 3.0), Vec3::new(1.0, 2.5, 3.0), Vec3::new(1.0, 2.5, -3.0)];
+        let mut triangles = [
+            Triangle::new(quad[0], quad[1], quad[2]),
+            Triangle::new(quad[0], quad[2], quad[3]),
+            Triangle::new(quad[0], quad[1], Vec3::new(2.0, 1.0, 0.0)),
+        ];
+        let alone = triangles.map(|t| t.cull);
+        Triangle::share_planes(&mut triangles.iter_mut().collect::<Vec<_>>());
+        assert_eq!(triangles[0].cull.plane, triangles[1].cull.plane);
+        assert_eq!(triangles[0].cull.plane.drop, 0);
+        assert_eq!(triangles[0].cull.plane.scale, 3.0);
+        assert_ne!(triangles[1].cull.edges, triangles[0].cull.edges);
+        assert_eq!(triangles[2].cull, alone[2]);
+        // Through the quad's shared diagonal: both let the ray through
+        let ray = Ray::new(Vec3::new(-1.0, 1.25, 0.0), Vec3::X);
+        for t in &triangles[..2] {
+            let crossing = Crossing::<f32>::of(ray.origin.into(), ray.direction.into(), &t.cull.plane);
+            assert!(!crossing.test(&t.cull.edges.splat(), f32::INFINITY).0);
+        }
     }
 
     #[test]

@@ -162,6 +162,7 @@ impl World {
         let centers: Vec<Vec3> = (0..world.spheres.radius.len()).map(|i| world.spheres.center(i)).collect();
         let ids = (0..centers.len() as u32).collect();
         world.spheres.lanes = SphereLanes::new(&centers, &world.spheres.radius, ids);
+        Triangle::share_planes(&mut world.triangles.iter_mut().map(|(triangle, _)| triangle).collect::<Vec<_>>());
         world.triangle_lanes = TriangleLanes::new(&world.triangles);
         if lo.x <= hi.x {
             world.bounds_center = (lo + hi) * 0.5;

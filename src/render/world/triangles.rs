@@ -10,15 +10,21 @@
 use glam::{BVec4A, Vec4};
 
 use crate::geometry::real::V3;
-use crate::geometry::{edges_of, may_reach_of, triangle_hit_of, watertight_finish_of, watertight_range_of, RayShear};
+use crate::geometry::{edges_of, triangle_hit_of, watertight_finish_of, watertight_range_of, Crossing, RayShear};
 use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
 
-/// Four triangles' vertices and bounding balls, lane by lane.
+/// Four triangles' vertices, planes and edges (`geometry::cull`), lane by
+/// lane.
 #[derive(Clone, Debug)]
 struct Group {
     vertices: [V3<Vec4>; 3],
-    center: V3<Vec4>,
-    radius: Vec4,
+    normal: V3<Vec4>,
+    offset: Vec4,
+    scale: Vec4,
+    /// Which axes each plane keeps: (y or x, y or z).
+    drop_x: BVec4A,
+    drop_z: BVec4A,
+    edges: [[Vec4; 3]; 3],
     /// Lanes that hold a triangle (the last group may be part empty).
     full: u32,
 }
@@ -27,6 +33,11 @@ struct Group {
 struct Verdict {
     /// Lanes hit within (0, t_max), by the f32 test.
     hit: u32,
+    /// Lanes whose crossing lies inside by more than the cull's slack
+    /// (`Crossing::test`): a shadow ray there is blocked.
+    sure: u32,
+    /// Where the ray crosses each lane's plane, and the slack.
+    crossing: Crossing<Vec4>,
     /// Lanes the ball lets through whose edge functions met an exact zero:
     /// the scalar test decides them (in f64).
     scalar: u32,
@@ -55,10 +66,16 @@ impl TriangleLanes {
                 let vec = |f: &dyn Fn(&Triangle) -> f32| Vec4::from_array([0, 1, 2, 3].map(|k| f(lane(k))));
                 let point =
                     |f: &dyn Fn(&Triangle) -> glam::Vec3| V3::new(vec(&|t| f(t).x), vec(&|t| f(t).y), vec(&|t| f(t).z));
+                let drops = |axis: usize| BVec4A::from_array([0, 1, 2, 3].map(|k| lane(k).cull.plane.drop == axis));
+                let edge = |e: usize, i: usize| vec(&|t| t.cull.edges.0[e][i]);
                 Group {
                     vertices: [point(&|t| t.vertices[0]), point(&|t| t.vertices[1]), point(&|t| t.vertices[2])],
-                    center: point(&|t| t.bound().0),
-                    radius: vec(&|t| t.bound().1),
+                    normal: point(&|t| t.cull.plane.normal),
+                    offset: vec(&|t| t.cull.plane.offset),
+                    scale: vec(&|t| t.cull.plane.scale),
+                    drop_x: drops(0),
+                    drop_z: drops(2),
+                    edges: [0, 1, 2].map(|e| [edge(e, 0), edge(e, 1), edge(e, 2)]),
                     full: (1 << chunk.len()) - 1,
                 }
             })
@@ -66,13 +83,18 @@ impl TriangleLanes {
         TriangleLanes { groups, ids }
     }
 
-    /// One group against `ray` within (0, t_max); `None` where its balls
-    /// turn the ray away in every lane (most groups, for most rays).
+    /// One group against `ray` within (0, t_max); `None` where the cull
+    /// turns the ray away in every lane (most groups, for most rays).
     #[inline(always)]
     fn verdict(group: &Group, ray: &Ray, shear: &RayShear<Vec4>, t_max: f32) -> Option<Verdict> {
         let (origin, direction) = (V3::<Vec4>::splat(ray.origin), V3::<Vec4>::splat(ray.direction));
         let limit = Vec4::splat(t_max);
-        let reach = may_reach_of(origin, direction, group.center, group.radius, limit).bitmask() & group.full;
+        let (t, point, slack) = Crossing::point_of(origin, direction, group.normal, group.offset, group.scale);
+        let u = Vec4::select(group.drop_x, point.y, point.x);
+        let v = Vec4::select(group.drop_z, point.y, point.z);
+        let crossing = Crossing { t, u, v, slack };
+        let (turned_away, sure) = crossing.test(&group.edges, limit);
+        let reach = !turned_away.bitmask() & group.full;
         if reach == 0 {
             return None;
         }
@@ -83,12 +105,13 @@ impl TriangleLanes {
         let scalar = on_edge.bitmask() & reach;
         let range = watertight_range_of(sheared, edges, sz, limit);
         let within = reach & !range.missed.bitmask() & !scalar;
-        if within == 0 && scalar == 0 {
+        let sure = sure.bitmask() & group.full;
+        if within == 0 && scalar == 0 && sure == 0 {
             return None;
         }
         let (t, hit, barycentrics) = watertight_finish_of(sheared, edges, range);
         let (t_scaled, det) = (range.t_scaled, range.det);
-        Some(Verdict { hit: hit.bitmask() & within, scalar, t, t_scaled, det, barycentrics })
+        Some(Verdict { hit: hit.bitmask() & within, sure, crossing, scalar, t, t_scaled, det, barycentrics })
     }
 
     /// Nearest hit in (0, t_max): (the world's triangle index, the hit),
@@ -114,16 +137,14 @@ impl TriangleLanes {
                     continue;
                 }
                 // An earlier lane of this group may have brought t_max
-                // nearer: the scalar loop would test both ball and hit
+                // nearer: the scalar loop would test both cull and hit
                 // against it
                 if narrowed {
-                    let (center, radius) = triangle.bound();
-                    let (origin, direction) = (V3::from(ray.origin), V3::from(ray.direction));
                     let (t_scaled, det) = (verdict.t_scaled.to_array()[lane], verdict.det.to_array()[lane]);
+                    let (crossing_t, slack) =
+                        (verdict.crossing.t.to_array()[lane], verdict.crossing.slack.to_array()[lane]);
                     let bound = best_t * det;
-                    if !may_reach_of(origin, direction, V3::from(center), radius, best_t)
-                        || (det < 0.0 && t_scaled < bound)
-                        || (det > 0.0 && t_scaled > bound)
+                    if crossing_t - slack > best_t || (det < 0.0 && t_scaled < bound) || (det > 0.0 && t_scaled > bound)
                     {
                         continue;
                     }
@@ -144,7 +165,7 @@ impl TriangleLanes {
         let shear = RayShear::of_one_ray(ray.origin, ray.direction);
         self.groups.iter().enumerate().any(|(g, group)| {
             let Some(verdict) = Self::verdict(group, ray, &shear, t_max) else { return false };
-            let mut lanes = verdict.hit | verdict.scalar;
+            let mut lanes = verdict.hit | verdict.sure | verdict.scalar;
             while lanes != 0 {
                 let lane = lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
@@ -152,7 +173,8 @@ impl TriangleLanes {
                 if skip(id) {
                     continue;
                 }
-                if verdict.hit & (1 << lane) != 0 || intersect_triangle(ray, &triangles[id as usize].0, t_max).is_some()
+                if (verdict.hit | verdict.sure) & (1 << lane) != 0
+                    || intersect_triangle(ray, &triangles[id as usize].0, t_max).is_some()
                 {
                     return true;
                 }

@@ -28,7 +28,7 @@ use crate::faults::{self, Fault};
 use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_finish_of, watertight_range_of, RayShear};
 use crate::geometry::{frame_from_z, gamma, intersect_triangle, offset_origin, to_world, Ray, SurfaceHit, Triangle};
-use crate::geometry::{may_reach_of, plane_exit_of, plane_point_of, plane_t_of};
+use crate::geometry::{plane_exit_of, plane_point_of, plane_t_of, Crossing};
 use crate::render::world::bsdf::{blinn_normalisation, reflect_of, refraction_of, Bsdf, Refraction};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
@@ -119,6 +119,9 @@ pub struct PathLanes {
     spheres: Vec<SphereInfo>,
     planes: Vec<PlaneInfo>,
     triangles: Vec<Triangle>,
+    /// Which run of triangles in one plane each belongs to
+    /// (`Triangle::share_planes`): a run's rays cross its plane once.
+    plane_runs: Vec<u32>,
     /// Each triangle's light plane (`World::light_plane`): a shadow ray
     /// toward a light on a triangle skips the triangles of its plane.
     triangle_planes: Vec<u32>,
@@ -233,6 +236,7 @@ impl PathLanes {
             spheres,
             planes,
             triangles: world.triangles.iter().map(|(triangle, _)| *triangle).collect(),
+            plane_runs: plane_runs(&world.triangles),
             triangle_planes: world.light_plane.clone(),
             surfaces,
             lights: LaneLights::new(world),
@@ -602,8 +606,9 @@ impl PathLanes {
         let (mut triangle_point, mut triangle_normal, mut triangle_error) =
             (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
         let shear = ray_shear_of(origin, direction);
+        let mut crossing = RunCrossing::new();
         for (j, triangle) in self.triangles.iter().enumerate() {
-            let near = self.may_reach(j, active, origin, direction, t_hit);
+            let near = self.cull(j, &mut crossing, active, origin, direction, t_hit).0;
             if !near.any() {
                 continue;
             }
@@ -732,15 +737,22 @@ impl PathLanes {
         (hits, t, point, error)
     }
 
-    /// Lanes of `mask` whose ray may reach triangle `j` before `t_max`
-    /// (`intersect_triangle`'s first test).
+    /// Lanes of `mask` whose ray may hit triangle `j` within (0, t_max),
+    /// and those sure to (`Crossing::test`: `intersect_triangle`'s first
+    /// test). `crossing` keeps where the rays cross the plane of the run
+    /// the last triangle asked about.
     #[inline(always)]
-    fn may_reach(&self, j: usize, mask: M8, origin: V8, direction: V8, t_max: F8) -> M8 {
-        let (center, radius) = self.triangles[j].bound();
-        if !mask.any() || self.triangles[j].is_degenerate() {
-            return M8::NONE;
+    fn cull(&self, j: usize, crossing: &mut RunCrossing, mask: M8, origin: V8, direction: V8, t_max: F8) -> (M8, M8) {
+        let triangle = &self.triangles[j];
+        if !mask.any() || triangle.is_degenerate() {
+            return (M8::NONE, M8::NONE);
         }
-        mask.and(may_reach_of(origin, direction, V8::splat(center), F8::splat(radius), t_max))
+        if crossing.run != self.plane_runs[j] {
+            *crossing =
+                RunCrossing { run: self.plane_runs[j], at: Crossing::of(origin, direction, &triangle.cull.plane) };
+        }
+        let (turned_away, surely) = crossing.at.test(&triangle.cull.edges.splat(), t_max);
+        (mask.and_not(turned_away), mask.and(surely))
     }
 
     /// Lanes whose segment (origin, unit direction, t_max) meets `sphere`.
@@ -783,13 +795,17 @@ impl PathLanes {
         // Triangles where the ray may reach them, but those in the plane of
         // the light triangle a ray ends on
         let shear = ray_shear_of(origin, direction);
+        let mut crossing = RunCrossing::new();
         for (j, (triangle, plane)) in self.triangles.iter().zip(&self.triangle_planes).enumerate() {
             let aimed_at = match skips {
                 Skips::All { plane: skip, .. } if *skip == Some(*plane) => continue,
                 Skips::All { .. } => M8::NONE,
                 Skips::Lanes { planes, .. } => M8::from_fn(|i| planes[i] == Some(*plane)),
             };
-            let near = self.may_reach(j, mask.and_not(blocked).and_not(aimed_at), origin, direction, t_max);
+            let open = mask.and_not(blocked).and_not(aimed_at);
+            let (near, surely) = self.cull(j, &mut crossing, open, origin, direction, t_max);
+            blocked = blocked.or(surely);
+            let near = near.and_not(surely);
             if near.any() {
                 blocked = blocked.or(Self::triangle_hits(triangle, near, origin, direction, &shear, t_max).0);
             }
@@ -852,6 +868,33 @@ enum Skips {
         spheres: [Option<u32>; LANES],
         planes: [Option<u32>; LANES],
     },
+}
+
+/// Where eight rays cross the plane of a run of triangles.
+struct RunCrossing {
+    run: u32,
+    at: Crossing<F8>,
+}
+
+impl RunCrossing {
+    /// Of no run yet.
+    #[inline(always)]
+    fn new() -> Self {
+        let zero = F8::splat(0.0);
+        RunCrossing { run: u32::MAX, at: Crossing { t: zero, u: zero, v: zero, slack: zero } }
+    }
+}
+
+/// Each triangle's run of triangles in one plane, counted from 0
+/// (`Triangle::share_planes` gave a run one plane).
+fn plane_runs(triangles: &[(Triangle, u32)]) -> Vec<u32> {
+    let mut run = 0;
+    (0..triangles.len())
+        .map(|j| {
+            run += (j > 0 && triangles[j].0.cull.plane != triangles[j - 1].0.cull.plane) as u32;
+            run
+        })
+        .collect()
 }
 
 /// Without lanes (a CPU without AVX2): the scalar tracer, sample by sample.
@@ -1000,12 +1043,12 @@ mod tests {
         }
         let (mut on_edges, mut hits_seen, mut misses_seen) = (0, 0, 0);
         for triangle in &triangles {
-            let (center, radius) = triangle.bound();
             for batch in rays.chunks(LANES) {
                 let origin = V8::from_fn(|i| batch[i].0);
                 let direction = V8::from_fn(|i| batch[i].1);
                 let t_max = F8::from_fn(|i| batch[i].2);
-                let near = may_reach_of(origin, direction, V8::splat(center), F8::splat(radius), t_max);
+                let crossing = Crossing::of(origin, direction, &triangle.cull.plane);
+                let near = !crossing.test(&triangle.cull.edges.splat(), t_max).0;
                 let shear = ray_shear_of(origin, direction);
                 let (hits, t, point, error) =
                     PathLanes::triangle_hits(triangle, near, origin, direction, &shear, t_max);

@@ -1,0 +1,156 @@
+//! Where a ray crosses a triangle's plane, the cheap test before the
+//! watertight one. Triangles that share a plane share the crossing: a ray
+//! computes it once for them all (the lanes do, over a run of coplanar
+//! triangles), then each triangle asks only whether the crossing lies
+//! within its three edges, two multiplies an edge in the plane's two kept
+//! axes. Unlike a bounding ball, which a ray passing beside a large
+//! triangle enters, the crossing turns away every ray but those that land
+//! on or near the triangle.
+//!
+//! The test is conservative by a slack far above the rounding of the
+//! crossing, of the edges and of the watertight test itself on any ray the
+//! tests run here, so a ray that lands on the triangle is never turned away
+//! (and a mesh stays watertight: both sides of a shared edge let its rays
+//! through). For shadow rays it also says which lanes land inside by more
+//! than the slack, well within their segment: those are blocked without
+//! the watertight test, which could only agree.
+
+use glam::{DVec2, DVec3, Vec3};
+
+use super::real::{Mask, Real, V3};
+
+/// The slack, relative to the magnitudes the crossing is computed from
+/// (about 128 ulps): rounding of the crossing, of the f32 plane and edges
+/// and of a triangle lying off its group's plane by `Triangle::holds_in_plane`'s
+/// 4 ulps come to a few ulps of them each.
+const SLACK: f32 = 1.0 / 65536.0;
+
+/// A plane as rays cross it: the one plane of a run of coplanar triangles
+/// (`Triangle::in_plane_of`), copied into each.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CullPlane {
+    /// Unit normal and offset: `normal · x = offset` on the plane.
+    pub normal: Vec3,
+    pub offset: f32,
+    /// The largest coordinate of any triangle in the plane, in magnitude:
+    /// the scale of the crossing's rounding.
+    pub scale: f32,
+    /// The axis the plane's triangles are projected along (the normal's
+    /// largest): 0, 1 or 2.
+    pub drop: usize,
+}
+
+/// A triangle's edges in its plane's two kept axes: the crossing (u, v) lies
+/// inside where `a·u + b·v + c ≥ 0` for all three, (a, b) a unit vector.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CullEdges(pub [[f32; 3]; 3]);
+
+/// A triangle's plane and edges.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleCull {
+    pub plane: CullPlane,
+    pub edges: CullEdges,
+}
+
+impl TriangleCull {
+    /// For `vertices` (not degenerate) in `plane`.
+    pub fn new(vertices: [Vec3; 3], plane: CullPlane) -> Self {
+        let flat = |v: Vec3| {
+            let v = v.as_dvec3();
+            match plane.drop {
+                0 => DVec2::new(v.y, v.z),
+                1 => DVec2::new(v.x, v.z),
+                _ => DVec2::new(v.x, v.y),
+            }
+        };
+        let q = vertices.map(flat);
+        let inward = if (q[1] - q[0]).perp_dot(q[2] - q[0]) >= 0.0 { 1.0 } else { -1.0 };
+        let edges = [0, 1, 2].map(|k| {
+            let (from, to) = (q[k], q[(k + 1) % 3]);
+            let along = to - from;
+            // A degenerate triangle (never tested) keeps finite edges
+            let normal = DVec2::new(-along.y, along.x) * (inward / along.length().max(f64::MIN_POSITIVE));
+            [normal.x as f32, normal.y as f32, -normal.dot(from) as f32]
+        });
+        TriangleCull { plane, edges: CullEdges(edges) }
+    }
+
+    /// The plane through `vertices` with unit `normal`, for triangles up
+    /// to `scale` in coordinate magnitude.
+    pub fn plane_of(vertices: [Vec3; 3], normal: Vec3, scale: f32) -> CullPlane {
+        let offset = normal.as_dvec3().dot(vertices.iter().map(|v| v.as_dvec3()).sum::<DVec3>() / 3.0) as f32;
+        CullPlane { normal, offset, scale, drop: normal.abs().max_position() }
+    }
+}
+
+/// Where rays cross a plane: the distance along each, the point in the
+/// plane's two kept axes, and the slack the tests allow it.
+#[derive(Clone, Copy)]
+pub struct Crossing<R: Real> {
+    pub t: R,
+    pub u: R,
+    pub v: R,
+    pub slack: R,
+}
+
+impl<R: Real> Crossing<R> {
+    /// Where each ray crosses the plane (`normal`, `offset`, `scale`); the
+    /// caller keeps two axes of the point (`Crossing::kept`). Rays along
+    /// the plane get an infinite or NaN distance and slack, which no test
+    /// turns away.
+    #[inline(always)]
+    pub fn point_of(origin: V3<R>, direction: V3<R>, normal: V3<R>, offset: R, scale: R) -> (R, V3<R>, R) {
+        let across = normal.dot(direction);
+        let t = (offset - normal.dot(origin)) / across;
+        let point = origin + direction * t;
+        let magnitude = origin.abs().element_sum() + t.abs() + scale;
+        (t, point, magnitude * SLACK / across.abs())
+    }
+
+    /// One plane's crossing for every lane.
+    #[inline(always)]
+    pub fn of(origin: V3<R>, direction: V3<R>, plane: &CullPlane) -> Self {
+        let normal = V3::new(R::splat(plane.normal.x), R::splat(plane.normal.y), R::splat(plane.normal.z));
+        let (t, point, slack) =
+            Self::point_of(origin, direction, normal, R::splat(plane.offset), R::splat(plane.scale));
+        let (u, v) = match plane.drop {
+            0 => (point.y, point.z),
+            1 => (point.x, point.z),
+            _ => (point.x, point.y),
+        };
+        Crossing { t, u, v, slack }
+    }
+
+    /// Lanes that may hit the triangle of `edges` within (0, t_max), and
+    /// those that surely do: their crossing inside every edge and within
+    /// the segment by more than the slack. Comparisons are written so that
+    /// a NaN lets a ray through and is never sure.
+    #[inline(always)]
+    pub fn test(&self, edges: &[[R; 3]; 3], t_max: R) -> (R::Mask, R::Mask) {
+        let Crossing { t, u, v, slack } = *self;
+        let outside = -slack;
+        let mut turned_away = t.lt(outside).or((t - slack).gt(t_max));
+        let mut sure = t.gt(slack).and((t + slack).lt(t_max));
+        for [a, b, c] in *edges {
+            let e = a * u + b * v + c;
+            turned_away = turned_away.or(e.lt(outside));
+            sure = sure.and(e.gt(slack));
+        }
+        (turned_away, sure)
+    }
+}
+
+impl CullEdges {
+    /// The edges splat into every lane.
+    #[inline(always)]
+    pub fn splat<R: Real>(&self) -> [[R; 3]; 3] {
+        // Written out: `map`'s closures are left out of line, without AVX2
+        let [e0, e1, e2] = self.0;
+        [splat3(e0), splat3(e1), splat3(e2)]
+    }
+}
+
+#[inline(always)]
+fn splat3<R: Real>([a, b, c]: [f32; 3]) -> [R; 3] {
+    [R::splat(a), R::splat(b), R::splat(c)]
+}
