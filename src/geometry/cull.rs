@@ -95,7 +95,7 @@ pub struct Crossing<R: Real> {
 
 impl<R: Real> Crossing<R> {
     /// Where each ray crosses the plane (`normal`, `offset`, `scale`); the
-    /// caller keeps two axes of the point (`Crossing::kept`). Rays along
+    /// caller keeps two axes of the point (as `of` does). Rays along
     /// the plane get an infinite or NaN distance and slack, which no test
     /// turns away.
     #[inline(always)]

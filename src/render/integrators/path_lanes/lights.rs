@@ -291,7 +291,7 @@ fn draw_on_caps(caps: &PerLane<CapLight>, p: V8, u: (F8, F8)) -> Drawn {
 /// Uniform over the cone each lane's sphere subtends, the point where the
 /// direction meets the sphere (`sample_area`); pdf 0 from inside it.
 #[inline(always)]
-fn draw_on_spheres(spheres: &PerLane<SphereLight>, p: V8, u: (F8, F8)) -> Drawn {
+fn draw_on_spheres(spheres: &PerLane<SphereLight>, lanes: M8, p: V8, u: (F8, F8)) -> Drawn {
     let (center, radius) = (spheres.v8(|sphere| sphere.center), spheres.f8(|sphere| sphere.radius));
     let one = F8::splat(1.0);
     let to_center = center - p;
@@ -308,9 +308,12 @@ fn draw_on_spheres(spheres: &PerLane<SphereLight>, p: V8, u: (F8, F8)) -> Drawn 
     let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
     let length = from_center.length();
     let hit_normal = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
-    // The cone's edge rays may miss by rounding: the closest approach
-    let miss_normal = (p + direction * to_center.dot(direction) - center).normalize();
-    let normal = hit.select_v(hit_normal, miss_normal);
+    // The cone's edge rays may miss by rounding (rarely): the closest approach
+    let mut normal = hit_normal;
+    if lanes.and_not(hit).any() {
+        let miss_normal = (p + direction * to_center.dot(direction) - center).normalize();
+        normal = hit.select_v(hit_normal, miss_normal);
+    }
     Drawn {
         target: center + normal * radius,
         normal,
@@ -391,7 +394,7 @@ impl LightLanes {
             in_lanes = in_lanes.or(lanes);
         }
         if let Some((lanes, spheres)) = lights.of_kind(pick, mask, 1, LaneLight::sphere) {
-            drawn = Some(draw_on_spheres(&spheres, point, u).over(lanes, drawn));
+            drawn = Some(draw_on_spheres(&spheres, lanes, point, u).over(lanes, drawn));
             in_lanes = in_lanes.or(lanes);
         }
         if let Some((lanes, triangles)) = lights.of_kind(pick, mask, 2, LaneLight::triangle) {
