@@ -29,12 +29,12 @@ use super::real::{Mask, Real, V3};
 
 /// The slack, relative to the magnitudes the crossing is computed from
 /// (about 128 ulps): rounding of the crossing, of the f32 plane and edges
-/// and of a triangle lying off its group's plane by `Triangle::holds_in_plane`'s
+/// and of a triangle lying off its run's plane by `Triangle::holds_in_plane`'s
 /// 4 ulps come to a few ulps of them each.
 const SLACK: f32 = 1.0 / 65536.0;
 
 /// A plane as rays cross it: the one plane of a run of coplanar triangles
-/// (`Triangle::in_plane_of`), copied into each.
+/// (`Triangle::share_planes`), copied into each.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CullPlane {
     /// Unit normal and offset: `normal · x = offset` on the plane.
