@@ -137,7 +137,7 @@ impl<R: Real> Crossing<R> {
     pub fn test(&self, edges: &[[R; 3]; 3], t_max: R) -> (R::Mask, R::Mask) {
         let Crossing { t, u, v, slack } = *self;
         let outside = -slack;
-        let mut turned_away = t.lt(outside).or((t - slack).gt(t_max));
+        let mut turned_away = t.lt(outside).or(beyond(t, slack, t_max));
         let mut sure = t.gt(slack).and((t + slack).lt(t_max));
         for [a, b, c] in *edges {
             let e = a * u + b * v + c;
@@ -146,6 +146,13 @@ impl<R: Real> Crossing<R> {
         }
         (turned_away, sure)
     }
+}
+
+/// Lanes whose crossing at `t` lies beyond `t_max` by more than the
+/// slack: the part of `Crossing::test` a nearer `t_max` changes.
+#[inline(always)]
+pub fn beyond<R: Real>(t: R, slack: R, t_max: R) -> R::Mask {
+    (t - slack).gt(t_max)
 }
 
 impl CullEdges {

@@ -10,7 +10,9 @@
 use glam::{BVec4A, Vec4};
 
 use crate::geometry::real::V3;
-use crate::geometry::{edges_of, triangle_hit_of, watertight_finish_of, watertight_range_of, Crossing, RayShear};
+use crate::geometry::{
+    beyond, edges_of, triangle_hit_of, watertight_finish_of, watertight_range_of, Crossing, RayShear,
+};
 use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
 
 /// Four triangles' vertices, planes and edges (`geometry::cull`), lane by
@@ -38,7 +40,7 @@ struct Verdict {
     sure: u32,
     /// Where the ray crosses each lane's plane, and the slack.
     crossing: Crossing<Vec4>,
-    /// Lanes the ball lets through whose edge functions met an exact zero:
+    /// Lanes the cull lets through whose edge functions met an exact zero:
     /// the scalar test decides them (in f64).
     scalar: u32,
     t: Vec4,
@@ -144,7 +146,9 @@ impl TriangleLanes {
                     let (crossing_t, slack) =
                         (verdict.crossing.t.to_array()[lane], verdict.crossing.slack.to_array()[lane]);
                     let bound = best_t * det;
-                    if crossing_t - slack > best_t || (det < 0.0 && t_scaled < bound) || (det > 0.0 && t_scaled > bound)
+                    if beyond(crossing_t, slack, best_t)
+                        || (det < 0.0 && t_scaled < bound)
+                        || (det > 0.0 && t_scaled > bound)
                     {
                         continue;
                     }

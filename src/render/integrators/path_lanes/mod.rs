@@ -1,6 +1,6 @@
 //! Path tracing eight paths at a time: each sphere, plane and triangle is
-//! tested against eight rays in one SIMD pass (a triangle behind an
-//! eight-ray test of its bounding ball), and the shading, the BSDFs and
+//! tested against eight rays in one SIMD pass (a triangle behind a test of
+//! where the rays cross its plane, `geometry::cull`), and the shading, the BSDFs and
 //! light sampling run in the same lanes. A lane whose path ends takes the
 //! next sample, so lanes stay busy however long the paths are.
 //!
@@ -601,7 +601,7 @@ impl PathLanes {
             }
         }
         // Triangles last, as both do: the watertight test in the lanes
-        // whose ray may reach the triangle's ball
+        // the cull lets through
         let first_triangle = first_plane + self.planes.len() as f32;
         let (mut triangle_point, mut triangle_normal, mut triangle_error) =
             (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
@@ -696,8 +696,8 @@ impl PathLanes {
         }
     }
 
-    /// `intersect_triangle` for the lanes of `near` (those `may_reach`
-    /// let through): which hit, and their distance, point and error bound.
+    /// `intersect_triangle` for the lanes of `near` (those `cull`
+    /// lets through): which hit, and their distance, point and error bound.
     /// Lanes on an edge, where the scalar code redoes the edge functions in
     /// f64, take the scalar code.
     #[inline(always)]
