@@ -38,12 +38,50 @@ fn depth_of(n: usize) -> usize {
 /// Segments at least this long split their halves between threads.
 const PARALLEL_SEGMENT: usize = 1 << 16;
 
-/// What the partition moves: a record's position and its index among the
-/// records, sixteen bytes, however large the record.
+/// What the partition moves, sixteen bytes however large a record is: a
+/// record's position as integers that order as `f32::total_cmp` orders
+/// the floats (`ordered`), and its index among the records. A step of the
+/// selection is then one integer comparison, where `total_cmp` took two
+/// conversions, and a segment's bounds are four-lane integer minima.
 #[derive(Clone, Copy)]
+#[repr(C, align(16))]
 struct Key {
-    position: Vec3,
-    record: u32,
+    /// x, y, z through `ordered`, then the record's index.
+    lanes: [i32; 4],
+}
+
+/// `x`'s bits as an integer that orders as `f32::total_cmp` orders floats
+/// (the same transform it makes); its own inverse.
+fn ordered(x: i32) -> i32 {
+    x ^ (((x >> 31) as u32) >> 1) as i32
+}
+
+impl Key {
+    fn new(position: Vec3, record: u32) -> Self {
+        let [x, y, z] = position.to_array().map(|c| ordered(c.to_bits() as i32));
+        Self { lanes: [x, y, z, record as i32] }
+    }
+
+    fn record(self) -> usize {
+        self.lanes[3] as u32 as usize
+    }
+}
+
+/// The axis of the keys' largest extent (ties to the lowest axis, as
+/// `Vec3::max_position` breaks them).
+fn widest_axis(keys: &[Key]) -> usize {
+    let (mut lo, mut hi) = ([i32::MAX; 4], [i32::MIN; 4]);
+    for key in keys {
+        // All four lanes, so that the loop runs as vector minima; the
+        // record's lane is not read
+        for c in 0..4 {
+            lo[c] = lo[c].min(key.lanes[c]);
+            hi[c] = hi[c].max(key.lanes[c]);
+        }
+    }
+    let float = |o: i32| f32::from_bits(ordered(o) as u32);
+    (Vec3::new(float(hi[0]), float(hi[1]), float(hi[2])) - Vec3::new(float(lo[0]), float(lo[1]), float(lo[2])))
+        .max_position()
 }
 
 /// Partition `keys` into a left-balanced tree's in-order: the median of the
@@ -59,19 +97,14 @@ fn partition(keys: &mut [Key], axes: &mut [u8]) {
         }
         return;
     }
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for key in keys.iter() {
-        lo = lo.min(key.position);
-        hi = hi.max(key.position);
-    }
-    let axis = (hi - lo).max_position();
+    let axis = widest_axis(keys);
     let median = left_subtree_size(length);
     // One comparison per axis, each compiled on its own (indexing by a
     // variable axis inside the comparison cost a third of the build)
     match axis {
-        0 => keys.select_nth_unstable_by(median, |a, b| a.position.x.total_cmp(&b.position.x)),
-        1 => keys.select_nth_unstable_by(median, |a, b| a.position.y.total_cmp(&b.position.y)),
-        _ => keys.select_nth_unstable_by(median, |a, b| a.position.z.total_cmp(&b.position.z)),
+        0 => keys.select_nth_unstable_by_key(median, |k| k.lanes[0]),
+        1 => keys.select_nth_unstable_by_key(median, |k| k.lanes[1]),
+        _ => keys.select_nth_unstable_by_key(median, |k| k.lanes[2]),
     };
     axes[median] = axis as u8;
     let (left, right) = keys.split_at_mut(median);
@@ -107,9 +140,9 @@ fn to_heap_order(records: &[Photon], keys: &[Key], axes: &[u8]) -> Vec<Photon> {
         top -= 1;
         // The reads go wherever the keys say: ask for one some way ahead
         if let Some(ahead) = keys.get(next + PREFETCH_AHEAD) {
-            prefetch(&records[ahead.record as usize]);
+            prefetch(&records[ahead.record()]);
         }
-        let mut record = records[keys[next].record as usize];
+        let mut record = records[keys[next].record()];
         record.set_axis(axes[next] as usize);
         tree[stack[top]] = record;
         next += 1;
@@ -129,8 +162,7 @@ impl PhotonKdTree {
         let n = photons.len();
         // Indices fit in u32, as the queries' stacks assume: the limits keep
         // every tree far smaller
-        let mut keys: Vec<Key> =
-            photons.iter().enumerate().map(|(i, p)| Key { position: p.position, record: i as u32 }).collect();
+        let mut keys: Vec<Key> = photons.iter().enumerate().map(|(i, p)| Key::new(p.position, i as u32)).collect();
         let mut axes = vec![0u8; n];
         partition(&mut keys, &mut axes);
         Self { photons: to_heap_order(&photons, &keys, &axes), depth: depth_of(n) }
