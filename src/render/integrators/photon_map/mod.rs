@@ -3,6 +3,7 @@
 //! and the hash grid that SPPM's gathers and VCM's merges search instead.
 
 pub mod cells;
+mod direction;
 pub mod emit;
 pub mod file;
 mod flight;

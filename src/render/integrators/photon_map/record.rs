@@ -1,11 +1,10 @@
 //! The photon record: 28 bytes — position (12), RGB power (12), incoming
 //! direction packed in two bytes as Jensen does (θ, φ quantised to 256
-//! steps), and the kd-tree's split axis.
-
-use std::f32::consts::PI;
-use std::sync::OnceLock;
+//! steps, `direction`), and the kd-tree's split axis.
 
 use glam::Vec3;
+
+use super::direction::{phi_step, tables, theta_step};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C)]
@@ -18,48 +17,11 @@ pub struct Photon {
     _pad: u8,
 }
 
-/// cos θ, sin θ, cos φ, sin φ at the centres of the 256 quantisation steps.
-struct DirectionTables {
-    cos_theta: [f32; 256],
-    sin_theta: [f32; 256],
-    cos_phi: [f32; 256],
-    sin_phi: [f32; 256],
-}
-
-fn tables() -> &'static DirectionTables {
-    static TABLES: OnceLock<DirectionTables> = OnceLock::new();
-    TABLES.get_or_init(|| {
-        let mut t =
-            DirectionTables { cos_theta: [0.0; 256], sin_theta: [0.0; 256], cos_phi: [0.0; 256], sin_phi: [0.0; 256] };
-        for i in 0..256 {
-            let theta = (i as f32 + 0.5) * (PI / 256.0);
-            let phi = (i as f32 + 0.5) * (2.0 * PI / 256.0);
-            t.cos_theta[i] = theta.cos();
-            t.sin_theta[i] = theta.sin();
-            t.cos_phi[i] = phi.cos();
-            t.sin_phi[i] = phi.sin();
-        }
-        t
-    })
-}
-
 impl Photon {
     /// `incoming_direction`: the unit direction the photon travels.
     pub fn new(position: Vec3, incoming_direction: Vec3, power: [f32; 3]) -> Self {
         let d = incoming_direction;
-        let theta = (d.z.clamp(-1.0, 1.0).acos() * (256.0 / PI)) as i32;
-        let mut phi = d.y.atan2(d.x) * (256.0 / (2.0 * PI));
-        if phi < 0.0 {
-            phi += 256.0;
-        }
-        Self {
-            position,
-            power,
-            theta: theta.clamp(0, 255) as u8,
-            phi: (phi as i32).clamp(0, 255) as u8,
-            axis: 0,
-            _pad: 0,
-        }
+        Self { position, power, theta: theta_step(d.z), phi: phi_step(d.x, d.y), axis: 0, _pad: 0 }
     }
 
     #[inline]
@@ -119,6 +81,8 @@ impl Photon {
 
 #[cfg(test)]
 mod tests {
+    use std::f32::consts::PI;
+
     use super::*;
     use crate::render::world::rng::Sampler;
     use crate::render::world::sampling::uniform_sphere;
