@@ -20,6 +20,7 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
+    gi_studio::render::engine::keep_freed_memory();
     let cli = Cli::parse();
     let result = match &cli.command {
         Some(Command::Render(args)) => gi_studio::cli::render::run(args),

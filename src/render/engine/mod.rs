@@ -4,11 +4,13 @@
 //! the CLI both drive it through a `RenderSession`.
 
 mod events;
+mod heap;
 mod job;
 mod session;
 mod workers;
 
 pub use events::{Notify, PassStats, RenderEvent, TileUpdate};
+pub use heap::keep_freed_memory;
 pub use job::RenderJob;
 pub use session::{render_blocking, render_blocking_on, RenderSession};
 pub use workers::Workers;

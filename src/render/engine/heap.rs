@@ -1,0 +1,65 @@
+//! What the process asks of the C allocator. A pass allocates its large
+//! buffers afresh (SPPM's photons, their grid's columns, light vertices)
+//! and frees them at its end; glibc hands such memory back to the kernel
+//! (an `mmap` per buffer above 128 KiB at first, and a thread's heap
+//! trimmed once 128 KiB lie free at its top), so the next pass faults every
+//! page in again, zeroed by the kernel. On SPPM's cornell at 256×192 that
+//! was 0.36 s of system time in 2.6 s of CPU.
+
+/// The largest `M_MMAP_THRESHOLD` glibc takes on 64-bit (half its 64 MiB
+/// thread heaps): buffers up to this size come from the heaps.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+const MMAP_THRESHOLD: i32 = 32 << 20;
+
+/// Keep memory freed by one pass for the next: buffers up to 32 MiB from
+/// the heaps, which are not trimmed. The process's footprint then stays at
+/// its peak (SPPM's cornell: 92 MiB where it fell back to 61 between
+/// passes). Elsewhere than glibc, nothing.
+#[allow(unsafe_code)]
+pub fn keep_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: mallopt takes two integers and changes only glibc's
+    // thresholds; a refusal returns 0 and leaves them as they were.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, MMAP_THRESHOLD);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
+    }
+}
+
+#[cfg(all(test, target_os = "linux", target_env = "gnu"))]
+mod tests {
+    use super::*;
+
+    /// Minor page faults this thread has taken.
+    #[allow(unsafe_code)]
+    fn faults() -> i64 {
+        // SAFETY: getrusage fills the zeroed struct it is given.
+        let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+        unsafe { libc::getrusage(libc::RUSAGE_THREAD, &mut usage) };
+        usage.ru_minflt
+    }
+
+    /// A pass's worth of buffers, freed and allocated again: the second
+    /// round finds its pages already there (without the thresholds, each
+    /// round faulted in all 4096 of them).
+    #[test]
+    fn a_buffer_freed_is_not_faulted_in_again() {
+        keep_freed_memory();
+        // A thread of its own: its own heap, and faults counted for it alone
+        std::thread::spawn(|| {
+            let pages = 4096;
+            let round = || {
+                let before = faults();
+                let buffer = std::hint::black_box(vec![1u8; pages * 4096]);
+                drop(buffer);
+                faults() - before
+            };
+            let first = round();
+            let second = round();
+            assert!(first > pages as i64 / 2, "the first round faults its pages in ({first})");
+            assert!(second < pages as i64 / 20, "{second} faults in the second round, {first} in the first");
+        })
+        .join()
+        .expect("the thread finishes");
+    }
+}
