@@ -443,6 +443,47 @@ fn bench_finds_the_presets_references_from_any_folder() {
     assert_eq!(cached(&cache), Vec::<String>::new(), "the built-in references need no cache");
 }
 
+/// FLIP in the bench's CSV, measured after the render (so as not to take
+/// its CPU) but in the rows of the passes it measured: the first pass's,
+/// then the first pass at 1.5 times the last one's time or later, and the
+/// final image's; the early, noisier images further from the reference.
+#[test]
+fn bench_measures_flip_at_log_spaced_passes() {
+    let dir = temp_dir("bench-flip");
+    let out = dir.join("results");
+    let output = gi_studio()
+        .args(["bench", "--budget", "0.6", "--algos", "path", "--reference-budget", "0", "--out"])
+        .arg(&out)
+        .arg("assets/scenes/cornell.ron")
+        .output()
+        .unwrap();
+    assert_exit(&output, 0);
+    let text = std::fs::read_to_string(out.join("convergence.csv")).unwrap();
+    // (seconds, FLIP if measured) of each pass
+    let rows: Vec<(f64, Option<f64>)> = text
+        .lines()
+        .skip(1)
+        .map(|line| {
+            let fields: Vec<&str> = line.split(',').collect();
+            (fields[2].parse().unwrap(), fields[7].parse().ok())
+        })
+        .collect();
+    assert!(rows.len() >= 8, "enough passes to space ({} rows)", rows.len());
+    let mut next = 0.0;
+    for (i, &(seconds, flip)) in rows.iter().enumerate() {
+        let due = seconds >= next || i == rows.len() - 1;
+        assert_eq!(flip.is_some(), due, "pass {i} at {seconds} s (FLIP due from {next} s)");
+        if seconds >= next {
+            next = seconds * 1.5;
+        }
+        if let Some(flip) = flip {
+            assert!(flip > 0.0 && flip < 1.0, "pass {i}: FLIP {flip}");
+        }
+    }
+    let (first, last) = (rows[0].1.unwrap(), rows[rows.len() - 1].1.unwrap());
+    assert!(first > last * 1.2, "one pass's FLIP {first}, the last's {last}");
+}
+
 #[test]
 fn an_edited_scene_gets_its_own_reference_and_bench_measures_against_it_from_elsewhere() {
     let dir = temp_dir("edited-reference");

@@ -68,9 +68,16 @@ pub struct Run {
     pub image: LinearImage,
 }
 
+/// Images kept for FLIP until the render ends, at most this many bytes:
+/// FLIP measured between passes took the CPU from the render it timed (its
+/// thread runs above the workers), 5–10% of a pass early on, where the
+/// table's times to an error are read. Past the bound (huge images over a
+/// long budget) FLIP is measured at once again.
+const FLIP_KEPT_BYTES: usize = 256 << 20;
+
 /// Render `scene` with `settings` on `workers` until its budget, logging
 /// error against `reference` after every pass (FLIP at roughly log-spaced
-/// times).
+/// times, measured once the render has ended).
 pub fn measure(
     workers: &Workers,
     scene: &Arc<ValidScene>,
@@ -85,6 +92,9 @@ pub fn measure(
     let mut image = LinearImage::new(width, height);
     let mut log = ConvergenceLog::default();
     let mut next_flip = 0.0;
+    // (point, image at that point) for FLIP after the render
+    let mut for_flip: Vec<(usize, LinearImage)> = Vec::new();
+    let image_bytes = std::mem::size_of_val(image.pixels.as_slice());
     loop {
         let event = session.events().recv().context("the render worker stopped")?;
         if event.generation() != generation {
@@ -100,16 +110,21 @@ pub fn measure(
             }
             RenderEvent::PassFinished { stats, .. } => {
                 let seconds = stats.elapsed.as_secs_f64();
-                let flip_now = seconds >= next_flip;
-                if flip_now {
+                let mut flip_now = None;
+                if seconds >= next_flip {
                     next_flip = seconds * 1.5;
+                    if (for_flip.len() + 1) * image_bytes <= FLIP_KEPT_BYTES {
+                        for_flip.push((log.points.len(), image.clone()));
+                    } else {
+                        flip_now = Some(flip(&image, &reference.image, 0.0)?);
+                    }
                 }
                 log.push(ConvergencePoint {
                     seconds,
                     samples_per_pixel: stats.passes,
                     rays: stats.rays,
                     error: rel_mse_against(&image, reference)?,
-                    flip: if flip_now { Some(flip(&image, &reference.image, 0.0)?) } else { None },
+                    flip: flip_now,
                 });
                 if let Some(bar) = progress {
                     bar.set_position((seconds * 10.0) as u64);
@@ -117,6 +132,9 @@ pub fn measure(
             }
             RenderEvent::Finished { image: last, stats, .. } => {
                 let image = Arc::try_unwrap(last).unwrap_or_else(|shared| (*shared).clone());
+                for (point, kept) in &for_flip {
+                    log.points[*point].flip = Some(flip(kept, &reference.image, 0.0)?);
+                }
                 if let Some(point) = log.points.last_mut() {
                     point.flip = Some(flip(&image, &reference.image, 0.0)?);
                 }
