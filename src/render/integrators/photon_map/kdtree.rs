@@ -67,8 +67,9 @@ impl Key {
     }
 }
 
-/// The axis of the keys' largest extent (ties to the lowest axis, as
-/// `Vec3::max_position` breaks them).
+/// The axis of the keys' largest extent, as `Vec3::max_position` picks it
+/// from the extents in floats (which the integer bounds give exactly, the
+/// positions being finite).
 fn widest_axis(keys: &[Key]) -> usize {
     let (mut lo, mut hi) = ([i32::MAX; 4], [i32::MIN; 4]);
     for key in keys {
