@@ -16,7 +16,8 @@ use super::next_event::lit_sum;
 use super::next_event::PathScope;
 use super::path_lanes::PathLanes;
 use super::photon_map::grid::PhotonGrid;
-use super::photon_map::trace::{trace_photons_until, MapKind};
+use super::photon_map::trace::{trace_photons_into, MapKind};
+use super::photon_map::Photon;
 use super::shadow_batch::ShadowBatch;
 use super::specular::{follow_specular, follow_specular_tile, Emission, Landing};
 use super::{Counters, PassObserver, PassReport, SppmTimes, Stage};
@@ -42,6 +43,8 @@ pub struct Sppm {
     /// The world for eight rays at a time, where it can be compiled: the
     /// eye pass's rays and shadow rays.
     lanes: Option<Box<PathLanes>>,
+    /// The last pass's photons: each pass traces into their memory.
+    photons: Vec<Photon>,
 }
 
 impl Sppm {
@@ -63,6 +66,7 @@ impl Sppm {
             max_depth: settings.max_depth,
             seed: settings.seed,
             lanes: PathLanes::new(world).map(Box::new),
+            photons: Vec::new(),
         }
     }
 
@@ -123,7 +127,8 @@ impl Sppm {
         let count = self.photons_per_pass;
         let keep_going = || observer.is_current();
         let (world, seed) = (stage.world, self.seed);
-        let photons = trace_photons_until(world, MapKind::Indirect, count, pass as u64, seed, max_depth, &keep_going)?;
+        let photons = &mut self.photons;
+        trace_photons_into(world, MapKind::Indirect, count, pass as u64, seed, max_depth, &keep_going, photons)?;
         times.trace = trace_start.elapsed();
         report.photon.photons_traced = count;
         report.photon.photons_stored = photons.len() as u64;
@@ -132,7 +137,7 @@ impl Sppm {
         let widest = (self.pixels.iter().flatten())
             .filter(|p| p.visible.is_some())
             .fold(0.0f32, |widest, p| widest.max(p.radius));
-        let grid = PhotonGrid::build(&photons, widest);
+        let grid = PhotonGrid::build(photons, widest);
         times.build = build_start.elapsed();
         if !observer.is_current() {
             return None;

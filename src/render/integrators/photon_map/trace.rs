@@ -37,8 +37,29 @@ pub fn trace_photons_until(
     max_depth: u32,
     keep_going: &(dyn Fn() -> bool + Sync),
 ) -> Option<Vec<Photon>> {
+    let mut photons = Vec::new();
+    trace_photons_into(world, kind, count, pass, seed, max_depth, keep_going, &mut photons)?;
+    Some(photons)
+}
+
+/// `trace_photons_until` into `photons`, emptied first, which keeps its
+/// memory from call to call: SPPM traces each pass into the last pass's
+/// array, whose pages are then there already (a million photons' array,
+/// 70 MB, is beyond what the heap keeps, `engine::keep_freed_memory`).
+#[allow(clippy::too_many_arguments)]
+pub fn trace_photons_into(
+    world: &World,
+    kind: MapKind,
+    count: u64,
+    pass: u64,
+    seed: u64,
+    max_depth: u32,
+    keep_going: &(dyn Fn() -> bool + Sync),
+    photons: &mut Vec<Photon>,
+) -> Option<()> {
+    photons.clear();
     let Some(tracing) = Tracing::new(world, kind, count, pass, seed, max_depth) else {
-        return Some(Vec::new());
+        return Some(());
     };
     // Built once for all the chunks: None where the world has no lanes
     let lanes = PathLanes::new(world);
@@ -56,7 +77,12 @@ pub fn trace_photons_until(
             Some(trace_chunk(lanes.as_ref(), &tracing, indices))
         })
         .collect();
-    Some(per_chunk?.concat())
+    let per_chunk = per_chunk?;
+    photons.reserve(per_chunk.iter().map(Vec::len).sum());
+    for chunk in &per_chunk {
+        photons.extend_from_slice(chunk);
+    }
+    Some(())
 }
 
 /// The photons `indices`: what they store, in photon order. Eight at a
