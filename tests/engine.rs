@@ -275,21 +275,32 @@ fn a_cancel_waits_for_at_most_one_tile_or_chunk_a_worker() {
     let world = World::new(&scene);
     let count = 100 * CHUNK;
     let asked = std::sync::atomic::AtomicUsize::new(0);
-    let all = trace_photons_until(&world, MapKind::Global, count, 0, 1, 8, &|| {
-        asked.fetch_add(1, Ordering::SeqCst);
-        true
-    });
+    let mut photons = Vec::new();
+    let all = trace_photons_until(
+        &world,
+        MapKind::Global,
+        count,
+        0,
+        1,
+        8,
+        &|| {
+            asked.fetch_add(1, Ordering::SeqCst);
+            true
+        },
+        &mut photons,
+    );
     assert!(all.is_some());
     assert_eq!(asked.load(Ordering::SeqCst), 100, "one question a chunk");
     // Told to stop at the fifth question: none but the chunks in flight go on
     let asked = std::sync::atomic::AtomicUsize::new(0);
     let traced = std::sync::atomic::AtomicUsize::new(0);
     let stopped = workers.run(|| {
-        trace_photons_until(&world, MapKind::Global, count, 0, 1, 8, &|| {
+        let keep_going = || {
             let go = asked.fetch_add(1, Ordering::SeqCst) < 5;
             traced.fetch_add(go as usize, Ordering::SeqCst);
             go
-        })
+        };
+        trace_photons_until(&world, MapKind::Global, count, 0, 1, 8, &keep_going, &mut photons)
     });
     assert!(stopped.is_none(), "an abandoned trace gives no map");
     assert_eq!(traced.load(Ordering::SeqCst), 5, "only the chunks told to go on were traced");

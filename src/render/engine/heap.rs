@@ -13,7 +13,7 @@ const MMAP_THRESHOLD: i32 = 32 << 20;
 
 /// Keep memory freed by one pass for the next: buffers up to 32 MiB from
 /// the heaps, which are not trimmed. The process's footprint then stays at
-/// its peak (SPPM's cornell: 92 MiB where it fell back to 61 between
+/// its peak (SPPM's cornell: 93 MiB where it fell back to 61 between
 /// passes). Elsewhere than glibc, nothing.
 #[allow(unsafe_code)]
 pub fn keep_freed_memory() {

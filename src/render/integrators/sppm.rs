@@ -16,7 +16,7 @@ use super::next_event::lit_sum;
 use super::next_event::PathScope;
 use super::path_lanes::PathLanes;
 use super::photon_map::grid::PhotonGrid;
-use super::photon_map::trace::{trace_photons_into, MapKind};
+use super::photon_map::trace::{trace_photons_until, MapKind};
 use super::photon_map::Photon;
 use super::shadow_batch::ShadowBatch;
 use super::specular::{follow_specular, follow_specular_tile, Emission, Landing};
@@ -128,7 +128,7 @@ impl Sppm {
         let keep_going = || observer.is_current();
         let (world, seed) = (stage.world, self.seed);
         let photons = &mut self.photons;
-        trace_photons_into(world, MapKind::Indirect, count, pass as u64, seed, max_depth, &keep_going, photons)?;
+        trace_photons_until(world, MapKind::Indirect, count, pass as u64, seed, max_depth, &keep_going, photons)?;
         times.trace = trace_start.elapsed();
         report.photon.photons_traced = count;
         report.photon.photons_stored = photons.len() as u64;

@@ -100,7 +100,8 @@ impl PhotonMaps {
     ) -> Option<Self> {
         let build = |kind: MapKind, count: u32| -> Option<(PhotonKdTree, MapStats)> {
             let start = Instant::now();
-            let photons = trace_photons_until(world, kind, count as u64, 0, seed, max_depth, keep_going)?;
+            let mut photons = Vec::new();
+            trace_photons_until(world, kind, count as u64, 0, seed, max_depth, keep_going, &mut photons)?;
             let trace_time = start.elapsed();
             if !keep_going() {
                 return None;

@@ -22,32 +22,19 @@ pub const CHUNK: u64 = 4096;
 
 /// Trace `count` photons for `kind`; stored powers are divided by `count`.
 pub fn trace_photons(world: &World, kind: MapKind, count: u64, pass: u64, seed: u64, max_depth: u32) -> Vec<Photon> {
-    trace_photons_until(world, kind, count, pass, seed, max_depth, &|| true).unwrap_or_default()
-}
-
-/// `trace_photons`, asking `keep_going` before each chunk of photons: None
-/// once it says no, after no more than the chunks already being traced
-/// (one a worker).
-pub fn trace_photons_until(
-    world: &World,
-    kind: MapKind,
-    count: u64,
-    pass: u64,
-    seed: u64,
-    max_depth: u32,
-    keep_going: &(dyn Fn() -> bool + Sync),
-) -> Option<Vec<Photon>> {
     let mut photons = Vec::new();
-    trace_photons_into(world, kind, count, pass, seed, max_depth, keep_going, &mut photons)?;
-    Some(photons)
+    trace_photons_until(world, kind, count, pass, seed, max_depth, &|| true, &mut photons);
+    photons
 }
 
-/// `trace_photons_until` into `photons`, emptied first, which keeps its
+/// `trace_photons` into `photons` (emptied first), asking `keep_going`
+/// before each chunk of photons: None once it says no, after no more than
+/// the chunks already being traced (one a worker). `photons` keeps its
 /// memory from call to call: SPPM traces each pass into the last pass's
 /// array, whose pages are then there already (a million photons' array,
 /// 70 MB, is beyond what the heap keeps, `engine::keep_freed_memory`).
 #[allow(clippy::too_many_arguments)]
-pub fn trace_photons_into(
+pub fn trace_photons_until(
     world: &World,
     kind: MapKind,
     count: u64,
