@@ -109,10 +109,16 @@ pub fn cosine_hemisphere_pdf_of<R: Real>(cos_theta: R) -> R {
 /// Uniform direction on the unit sphere; pdf = 1 / 4π.
 #[inline]
 pub fn uniform_sphere(u: Vec2) -> Vec3 {
-    let z = 1.0 - 2.0 * u.x;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let (sin, cos) = sin_cos(2.0 * PI * u.y);
-    Vec3::new(r * cos, r * sin, z)
+    uniform_sphere_of(u.x, u.y).into()
+}
+
+/// `uniform_sphere` for one sample or several.
+#[inline(always)]
+pub fn uniform_sphere_of<R: Real>(u0: R, u1: R) -> V3<R> {
+    let z = R::splat(1.0) - u0 * 2.0;
+    let r = (R::splat(1.0) - z * z).max(R::splat(0.0)).sqrt();
+    let (sin, cos) = sin_cos_of(u1 * (2.0 * PI));
+    V3::new(r * cos, r * sin, z)
 }
 
 /// The density of `uniform_sphere`: 1/(4π) per steradian.

@@ -2,13 +2,16 @@
 //! and triangles), points, spots and directional lights in the lanes, the
 //! background through the scalar code lane by lane.
 
+use std::f32::consts::PI;
+
 use glam::{Vec2, Vec3};
 
 use crate::geometry::sphere::nearest_root;
 use crate::geometry::{frame_from_z, offset_origin, ray_to, to_world, SurfaceHit};
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
 use crate::render::world::light::{solid_angle_pdf_of, triangle_point_of, Emitter, LightSource};
-use crate::render::world::sampling::{uniform_cone_of, uniform_cone_pdf_of, uniform_triangle_of};
+use crate::render::world::sampling::{cosine_hemisphere_of, uniform_cone_of, uniform_cone_pdf_of};
+use crate::render::world::sampling::{uniform_sphere_of, uniform_triangle_of};
 use crate::render::world::World;
 use crate::scene::{Attenuation, Rgb};
 
@@ -44,6 +47,7 @@ struct SphereLight {
     center: Vec3,
     radius: f32,
     error: f32,
+    area: f32,
     radiance: Rgb,
 }
 
@@ -94,10 +98,10 @@ impl LaneLight {
             }
             LightSource::Background { .. } => return None,
         };
-        let error = emitter.error();
+        let (error, area) = (emitter.error(), emitter.area());
         Some(match emitter {
             Emitter::Sphere { center, radius, cap, .. } if cap.is_whole() => {
-                LaneLight::Sphere(SphereLight { center, radius, error, radiance })
+                LaneLight::Sphere(SphereLight { center, radius, error, area, radiance })
             }
             Emitter::Sphere { center, radius, cap, .. } => LaneLight::Cap(CapLight {
                 center,
@@ -105,13 +109,13 @@ impl LaneLight {
                 error,
                 frame: [cap.frame.x, cap.frame.y, cap.frame.z],
                 one_minus_cos: cap.one_minus_cos,
-                area: cap.area(radius),
+                area,
                 radiance,
             }),
             Emitter::Triangle { shape, .. } => LaneLight::Triangle(TriangleLight {
                 vertices: shape.vertices,
                 normal: shape.normal,
-                area: shape.area(),
+                area,
                 error,
                 radiance,
             }),
@@ -323,12 +327,22 @@ fn draw_on_spheres(spheres: &PerLane<SphereLight>, lanes: M8, p: V8, u: (F8, F8)
     }
 }
 
+/// Each lane's triangle's corners. Written out: a closure over the corner
+/// index is left out of line, without AVX2.
+#[inline(always)]
+fn triangle_vertices(triangles: &PerLane<TriangleLight>) -> [V8; 3] {
+    [
+        triangles.v8(|triangle| triangle.vertices[0]),
+        triangles.v8(|triangle| triangle.vertices[1]),
+        triangles.v8(|triangle| triangle.vertices[2]),
+    ]
+}
+
 /// Uniform over each lane's triangle (`sample_area`).
 #[inline(always)]
 fn draw_on_triangles(triangles: &PerLane<TriangleLight>, p: V8, u: (F8, F8)) -> Drawn {
     let (b0, b1) = uniform_triangle_of(u.0, u.1);
-    let vertex = |k: usize| triangles.v8(|triangle| triangle.vertices[k]);
-    let target = triangle_point_of([vertex(0), vertex(1), vertex(2)], b0, b1);
+    let target = triangle_point_of(triangle_vertices(triangles), b0, b1);
     let normal = triangles.v8(|triangle| triangle.normal);
     Drawn {
         target,
@@ -446,6 +460,108 @@ impl LightLanes {
                 out.origin.set_lane(lane, sample.shadow.origin);
                 out.t_max.set_lane(lane, sample.shadow_t_max);
             }
+        }
+        out
+    }
+}
+
+/// Starts of light in eight lanes (`LightSource::emit`): where each leaves,
+/// along what, carrying what (before the light's pick probability).
+pub(crate) struct EmittedLanes {
+    pub(crate) origin: V8,
+    pub(crate) direction: V8,
+    pub(crate) power: V8,
+}
+
+/// Points drawn uniformly on area lights, before their direction.
+struct OnLight {
+    point: V8,
+    normal: V8,
+    error: F8,
+    area: F8,
+    radiance: V8,
+}
+
+impl OnLight {
+    #[inline(always)]
+    fn over(self, mask: M8, before: Option<OnLight>) -> OnLight {
+        let Some(b) = before else { return self };
+        OnLight {
+            point: mask.select_v(self.point, b.point),
+            normal: mask.select_v(self.normal, b.normal),
+            error: mask.select(self.error, b.error),
+            area: mask.select(self.area, b.area),
+            radiance: mask.select_v(self.radiance, b.radiance),
+        }
+    }
+}
+
+impl LaneLights {
+    /// `LightSource::emit` for each lane's light (`pick`), in the lanes of
+    /// `mask`: area lights and point lights in the lanes; spots,
+    /// directional lights and the background lane by lane.
+    #[inline(always)]
+    pub(super) fn emit(
+        &self,
+        world: &World,
+        pick: &[usize; LANES],
+        mask: M8,
+        u1: (F8, F8),
+        u2: (F8, F8),
+    ) -> EmittedLanes {
+        let mut out =
+            EmittedLanes { origin: V8::splat(Vec3::ZERO), direction: V8::splat(Vec3::Z), power: V8::splat(Vec3::ZERO) };
+        let (mut on_light, mut in_lanes) = (None, M8::NONE);
+        // A point uniform over the light's area (`point_on_emitter`)
+        if let Some((lanes, caps)) = self.of_kind(pick, mask, 0, LaneLight::cap) {
+            let frame = [caps.v8(|cap| cap.frame[0]), caps.v8(|cap| cap.frame[1]), caps.v8(|cap| cap.frame[2])];
+            let normal = to_world(frame, uniform_cone_of(u1.0, u1.1, caps.f8(|cap| cap.one_minus_cos)));
+            let point = caps.v8(|cap| cap.center) + normal * caps.f8(|cap| cap.radius);
+            let (error, area, radiance) =
+                (caps.f8(|cap| cap.error), caps.f8(|cap| cap.area), caps.v8(|cap| cap.radiance));
+            on_light = Some(OnLight { point, normal, error, area, radiance }.over(lanes, on_light));
+            in_lanes = in_lanes.or(lanes);
+        }
+        if let Some((lanes, spheres)) = self.of_kind(pick, mask, 1, LaneLight::sphere) {
+            let normal = uniform_sphere_of(u1.0, u1.1);
+            let point = spheres.v8(|sphere| sphere.center) + normal * spheres.f8(|sphere| sphere.radius);
+            let (error, area) = (spheres.f8(|sphere| sphere.error), spheres.f8(|sphere| sphere.area));
+            let radiance = spheres.v8(|sphere| sphere.radiance);
+            on_light = Some(OnLight { point, normal, error, area, radiance }.over(lanes, on_light));
+            in_lanes = in_lanes.or(lanes);
+        }
+        if let Some((lanes, triangles)) = self.of_kind(pick, mask, 2, LaneLight::triangle) {
+            let (b0, b1) = uniform_triangle_of(u1.0, u1.1);
+            let point = triangle_point_of(triangle_vertices(&triangles), b0, b1);
+            let normal = triangles.v8(|triangle| triangle.normal);
+            let (error, area) = (triangles.f8(|triangle| triangle.error), triangles.f8(|triangle| triangle.area));
+            let radiance = triangles.v8(|triangle| triangle.radiance);
+            on_light = Some(OnLight { point, normal, error, area, radiance }.over(lanes, on_light));
+            in_lanes = in_lanes.or(lanes);
+        }
+        if let Some(OnLight { point, normal, error, area, radiance }) = on_light {
+            // Cosine-weighted about the normal: L cos θ / (pdf_area · cos θ/π) = π L A
+            let direction = to_world(frame_from_z(normal), cosine_hemisphere_of(u2.0, u2.1));
+            out.origin = offset_origin(point, error, normal, direction);
+            out.direction = direction;
+            out.power = radiance * (F8::splat(PI) * area);
+        }
+        // Point lights, not spots: uniform over the sphere of directions
+        if let Some((lanes, points)) = self.of_kind(pick, mask, 3, LaneLight::point) {
+            let lanes = lanes.and(points.f8(|light| light.cos_cone).eq(F8::splat(f32::NEG_INFINITY)));
+            if lanes.any() {
+                out.origin = lanes.select_v(points.v8(|light| light.position), out.origin);
+                out.direction = lanes.select_v(uniform_sphere_of(u1.0, u1.1), out.direction);
+                out.power = lanes.select_v(points.v8(|light| light.intensity) * F8::splat(4.0 * PI), out.power);
+                in_lanes = in_lanes.or(lanes);
+            }
+        }
+        for lane in mask.and_not(in_lanes).lanes() {
+            let u = |(u0, u1): (F8, F8)| Vec2::new(u0.lane(lane), u1.lane(lane));
+            let emission = world.lights[pick[lane]].emit(world.bounds(), u(u1), u(u2));
+            out.origin.set_lane(lane, emission.ray.origin);
+            out.direction.set_lane(lane, emission.ray.direction);
+            out.power.set_lane(lane, emission.power);
         }
         out
     }

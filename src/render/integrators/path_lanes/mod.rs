@@ -18,23 +18,25 @@ use glam::Vec3;
 mod glossy;
 mod lights;
 mod samples;
+mod scatter;
 
-use glossy::GlossyLanes;
+pub(crate) use lights::EmittedLanes;
 use lights::{LaneLights, LightLanes};
 use samples::{CameraSample, CameraSamples};
+pub(crate) use scatter::{LaneSurfaces, Scattered};
 
 use super::Counters;
 use crate::faults::{self, Fault};
 use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_finish_of, watertight_range_of, RayShear};
-use crate::geometry::{frame_from_z, gamma, intersect_triangle, offset_origin, to_world, Ray, SurfaceHit, Triangle};
+use crate::geometry::{gamma, intersect_triangle, offset_origin, Ray, SurfaceHit, Triangle};
 use crate::geometry::{plane_exit_of, plane_point_of, plane_t_of, Crossing};
-use crate::render::world::bsdf::{blinn_normalisation, reflect_of, refraction_of, Bsdf, Refraction};
+use crate::render::world::bsdf::{blinn_normalisation, Bsdf, Transport};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSource};
 use crate::render::world::occluders::Shadow;
-use crate::render::world::sampling::{cosine_hemisphere_of, power_heuristic, power_heuristic_of, uniform_sphere_pdf};
+use crate::render::world::sampling::{power_heuristic, power_heuristic_of, uniform_sphere_pdf};
 use crate::render::world::{Hit, ShapeRef, World};
 use crate::scene::{MaterialModel, Rgb};
 
@@ -103,14 +105,15 @@ struct Occluder {
 }
 
 /// What `PathLanes::nearest` finds for eight rays.
-struct LaneHits {
-    found: M8,
+pub(crate) struct LaneHits {
+    pub(crate) found: M8,
     t: F8,
     /// Spheres, then planes, then triangles: an index into `surfaces`.
     shape: [i32; LANES],
-    point: V8,
-    normal: V8,
-    error: F8,
+    pub(crate) point: V8,
+    /// The geometric normal.
+    pub(crate) normal: V8,
+    pub(crate) error: F8,
 }
 
 /// A world compiled for eight-lane path tracing.
@@ -285,6 +288,31 @@ impl PathLanes {
         })
     }
 
+    /// The nearest hits of the rays of `active` (`held` those inside every
+    /// wall) and the surfaces there, for callers that bounce in the lanes
+    /// (photons). Fast only inlined into code built for AVX2.
+    #[inline(always)]
+    pub(crate) fn hit_surfaces(&self, active: M8, held: M8, origin: V8, direction: V8) -> (LaneHits, LaneSurfaces<'_>) {
+        let hits = self.nearest(active, held, origin, direction);
+        let surfaces = LaneSurfaces::new(&self.surfaces, &hits.shape, hits.found);
+        (hits, surfaces)
+    }
+
+    /// `LightSource::emit` for each lane's light (`pick`, an index into
+    /// the world's lights) in the lanes of `mask`, from the draws `u1`, `u2`.
+    /// Fast only inlined into code built for AVX2.
+    #[inline(always)]
+    pub(crate) fn emit(
+        &self,
+        world: &World,
+        pick: &[usize; LANES],
+        mask: M8,
+        u1: (F8, F8),
+        u2: (F8, F8),
+    ) -> EmittedLanes {
+        self.lights.emit(world, pick, mask, u1, u2)
+    }
+
     /// The radiance of every camera sample of `tile`, into `out` (one per sample).
     pub fn radiance(&self, world: &World, tile: &CameraTile, max_depth: u32, out: &mut [Rgb], counters: &mut Counters) {
         if !lanes::supported() {
@@ -381,14 +409,10 @@ impl PathLanes {
         if !alive.any() {
             return missed;
         }
-        let surface: [&Surface; LANES] = lanes::each(|i| &self.surfaces[shape[i] as usize]);
-        let code = F8::from_fn(|i| surface[i].kind);
-        let kind = |k: f32| code.eq(F8::splat(k)).and(alive);
-        let (lambert, mirror, glass, emissive) = (kind(LAMBERT), kind(MIRROR), kind(GLASS), kind(EMITTER));
-        let glossy = GlossyLanes::new(&surface, code, alive);
+        let surfaces = LaneSurfaces::new(&self.surfaces, &shape, alive);
+        let LaneSurfaces { surface, emissive, ref glossy, color, .. } = surfaces;
         // What next-event estimation shades
-        let diffuse = lambert.or(glossy.mask());
-        let color = V8::from_fn(|i| surface[i].color);
+        let diffuse = surfaces.lambert.or(glossy.mask());
         let wo = -direction;
         let hit = |i: usize| SurfaceHit {
             t: t_hit.lane(i),
@@ -461,44 +485,9 @@ impl PathLanes {
         }
 
         // Scattering: each material draws what it uses (`Bsdf::sample`)
-        let mut wi = reflect_of(wo, facing);
-        let mut weight = color;
-        let mut pdf = F8::splat(1.0);
-        let mut scattered = mirror;
-        if lambert.any() {
-            let (u0, u1) = st.rng.next_2d(lambert);
-            let w = to_world(frame_from_z(facing), cosine_hemisphere_of(u0, u1));
-            let cos = w.dot(facing);
-            let ok = lambert.and(cos.gt(zero));
-            wi = ok.select_v(w, wi);
-            pdf = ok.select(cos.max(zero) * FRAC_1_PI, pdf);
-            scattered = scattered.or(ok);
-        }
-        if glossy.mask().any() {
-            let u_lobe = st.rng.next_f32(glossy.mask());
-            let u = st.rng.next_2d(glossy.mask());
-            let (ok, w, f_cos_over_pdf, p) = glossy.sample(wo, facing, u_lobe, u);
-            wi = ok.select_v(w, wi);
-            weight = ok.select_v(f_cos_over_pdf, weight);
-            pdf = ok.select(p, pdf);
-            scattered = scattered.or(ok);
-        }
-        if glass.any() {
-            let ior = F8::from_fn(|i| surface[i].ior);
-            let entering = wo.dot(normal).gt(zero);
-            let eta_i = entering.select(F8::splat(1.0), ior);
-            let eta_t = entering.select(ior, F8::splat(1.0));
-            let Refraction { fresnel, direction: refracted, eta, total } = refraction_of(wo, facing, eta_i, eta_t);
-            let u_lobe = st.rng.next_f32(glass.and_not(total));
-            let through = glass.and_not(total).and(u_lobe.ge(fresnel));
-            let bounced = glass.and_not(through);
-            wi = through.select_v(refracted, wi);
-            weight = through.select_v(color * (eta * eta), weight);
-            pdf = through.select(1.0 - fresnel, bounced.select(fresnel, pdf));
-            scattered = scattered.or(glass);
-        }
-        let go = scattered;
-        let done = missed.or(alive.and_not(scattered));
+        let Scattered { go, wi, weight, pdf, .. } =
+            surfaces.scatter(&mut st.rng, wo, normal, facing, Transport::Radiance);
+        let done = missed.or(alive.and_not(go));
         if !go.any() {
             return done;
         }

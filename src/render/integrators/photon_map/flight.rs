@@ -2,7 +2,8 @@
 //! hit is stored if its map keeps it and scattered by the surface, with
 //! Russian roulette at diffuse surfaces (`Tracing::bounce`). Photon i's
 //! random stream is fixed by (i, pass, seed). `trace` flies photons by
-//! these two, eight at a time or one (`flying`).
+//! these two one at a time (`flying`), and `flight_lanes` eight at a time
+//! as these two do.
 
 use glam::Vec3;
 
@@ -11,7 +12,7 @@ use super::record::Photon;
 use crate::faults::{self, Fault};
 use crate::geometry::Ray;
 use crate::render::world::bsdf::{Bsdf, Transport};
-use crate::render::world::rng::Sampler;
+use crate::render::world::rng::{PassStreams, Sampler};
 use crate::render::world::{Hit, World};
 use crate::scene::Rgb;
 
@@ -30,6 +31,19 @@ pub enum MapKind {
     All,
 }
 
+impl MapKind {
+    /// The bounces, and of them the diffuse ones, a photon must have made
+    /// before its map keeps it at a non-specular hit.
+    #[inline(always)]
+    pub(super) fn stores_after(self) -> (u32, u32) {
+        match self {
+            MapKind::Global => (0, 1),
+            MapKind::Caustic | MapKind::Indirect => (1, 0),
+            MapKind::All => (0, 0),
+        }
+    }
+}
+
 /// Keeps photon streams apart from camera streams with the same indices.
 const PHOTON_SALT: u64 = 0x5eed_f07f_0000_0001;
 
@@ -43,18 +57,18 @@ pub(super) struct Tracing<'a> {
     /// 1 / the photon count: each stored power's share.
     scale: f32,
     max_depth: u32,
-    pass: u64,
-    seed: u64,
+    /// The photons' random streams in this pass.
+    streams: PassStreams,
 }
 
 /// One photon between its bounces.
 pub(super) struct Flight {
     pub(super) ray: Ray,
     pub(super) held: bool,
-    power: Rgb,
-    depth: u32,
-    diffuse_bounces: u32,
-    sampler: Sampler,
+    pub(super) power: Rgb,
+    pub(super) depth: u32,
+    pub(super) diffuse_bounces: u32,
+    pub(super) sampler: Sampler,
 }
 
 impl<'a> Tracing<'a> {
@@ -76,24 +90,51 @@ impl<'a> Tracing<'a> {
         if kind == MapKind::Caustic && targets.is_empty() {
             return None;
         }
-        Some(Tracing { world, kind, picker, targets, scale: 1.0 / count as f32, max_depth, pass, seed })
+        let streams = PassStreams::new(pass, seed ^ PHOTON_SALT ^ kind as u64);
+        Some(Tracing { world, kind, picker, targets, scale: 1.0 / count as f32, max_depth, streams })
     }
 
     pub(super) fn world(&self) -> &'a World {
         self.world
     }
 
+    /// Each stored power's share: 1 / the photon count.
+    pub(super) fn power_scale(&self) -> f32 {
+        if faults::active(Fault::PhotonPowerHigh) {
+            self.scale * 1.05
+        } else {
+            self.scale
+        }
+    }
+
+    pub(super) fn picker(&self) -> &LightPicker {
+        &self.picker
+    }
+
+    /// Photon `index`'s random stream.
+    pub(super) fn stream(&self, index: u64) -> Sampler {
+        self.streams.sampler(index)
+    }
+
+    pub(super) fn kind(&self) -> MapKind {
+        self.kind
+    }
+
+    pub(super) fn max_depth(&self) -> u32 {
+        self.max_depth
+    }
+
     /// Photon `index`, leaving its light: None if it leaves none, or may
     /// not bounce at all.
     pub(super) fn launch(&self, index: u64) -> Option<Flight> {
         let world = self.world;
-        let mut sampler = Sampler::new(index, self.pass, self.seed ^ PHOTON_SALT ^ self.kind as u64);
+        let mut sampler = self.stream(index);
         let emitted = match self.kind {
             MapKind::Caustic => emit_toward(world, &self.picker, &self.targets, &mut sampler),
             _ => emit(world, &self.picker, &mut sampler),
         };
         let EmittedPhoton { ray, power } = emitted.filter(|_| self.max_depth > 0)?;
-        let scale = if faults::active(Fault::PhotonPowerHigh) { self.scale * 1.05 } else { self.scale };
+        let scale = self.power_scale();
         let held = world.holds(ray.origin);
         Some(Flight { ray, held, power: power * scale, depth: 0, diffuse_bounces: 0, sampler })
     }
@@ -105,12 +146,8 @@ impl<'a> Tracing<'a> {
         let kind = self.kind;
         let bsdf = Bsdf::new(self.world.material_of(hit));
         if !bsdf.is_specular() {
-            let keep = match kind {
-                MapKind::Global => flight.diffuse_bounces > 0,
-                MapKind::Caustic => flight.depth > 0,
-                MapKind::Indirect => flight.depth > 0,
-                MapKind::All => true,
-            };
+            let (bounces, diffuse_bounces) = kind.stores_after();
+            let keep = flight.depth >= bounces && flight.diffuse_bounces >= diffuse_bounces;
             if keep && flight.power.is_finite() {
                 store(Photon::new(hit.surface.point, flight.ray.direction, flight.power.to_array()));
             }

@@ -7,6 +7,7 @@ mod direction;
 pub mod emit;
 pub mod file;
 mod flight;
+mod flight_lanes;
 pub mod grid;
 pub mod kdtree;
 pub mod maps;

@@ -3,8 +3,9 @@
 //! hits according to which map they are for. Photon i's random stream is
 //! fixed by (i, pass, seed), and chunks are joined in order, so the maps do
 //! not depend on the thread count. Eight photons are traced at a time
-//! where the CPU and the world allow (`flying`), then put back in photon
-//! order (`reorder`): the same maps, bit for bit.
+//! where the CPU and the world allow (`flight_lanes`; one at a time
+//! through `flying` otherwise), then put back in photon order
+//! (`reorder`): the same maps, bit for bit.
 
 use std::ops::Range;
 
@@ -78,17 +79,25 @@ pub fn trace_photons_until(
 fn trace_chunk(path_lanes: Option<&PathLanes>, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
     // Each stored photon, and its photon's place among `indices`
     let (mut stored, mut places) = (Vec::new(), Vec::new());
-    let bounce = |place, flight: &mut Flight, hit: Option<&Hit>| {
-        hit.is_some_and(|hit| {
-            tracing.bounce(flight, hit, &mut |photon| {
-                stored.push(photon);
-                places.push(place);
-            })
-        })
-    };
-    let ray = |flight: &Flight| (flight.ray, flight.held);
     let items = (indices.end - indices.start) as usize;
-    flying::fly(path_lanes, tracing.world(), indices, |index| tracing.launch(index), ray, bounce);
+    match path_lanes.filter(|_| PathLanes::runs_in_lanes()) {
+        Some(path_lanes) => tracing.fly_in_lanes(path_lanes, indices, |place, photon| {
+            stored.push(photon);
+            places.push(place);
+        }),
+        None => {
+            let bounce = |place, flight: &mut Flight, hit: Option<&Hit>| {
+                hit.is_some_and(|hit| {
+                    tracing.bounce(flight, hit, &mut |photon| {
+                        stored.push(photon);
+                        places.push(place);
+                    })
+                })
+            };
+            let ray = |flight: &Flight| (flight.ray, flight.held);
+            flying::fly(None, tracing.world(), indices, |index| tracing.launch(index), ray, bounce);
+        }
+    }
     reorder::by_item(&stored, &places, items).0
 }
 

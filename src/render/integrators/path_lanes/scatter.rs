@@ -1,0 +1,114 @@
+//! What the surfaces at eight hits are, and the directions they scatter
+//! into: `Bsdf::sample` in the lanes, for camera paths (radiance) and
+//! photons (importance) alike, each material drawing from the lanes'
+//! streams only the numbers the scalar code draws.
+
+use std::f32::consts::FRAC_1_PI;
+
+use super::glossy::GlossyLanes;
+use super::{Surface, EMITTER, GLASS, LAMBERT, MIRROR};
+use crate::geometry::{frame_from_z, to_world};
+use crate::render::world::bsdf::{reflect_of, refraction_of, Refraction, Transport};
+use crate::render::world::lanes::{self, Rng8, F8, LANES, M8, V8};
+use crate::render::world::sampling::cosine_hemisphere_of;
+
+/// The surfaces of the lanes of `alive`, by material.
+pub(crate) struct LaneSurfaces<'a> {
+    pub(super) surface: [&'a Surface; LANES],
+    pub(crate) lambert: M8,
+    pub(crate) mirror: M8,
+    pub(crate) glass: M8,
+    /// Emitters, and surfaces that neither reflect nor emit.
+    pub(crate) emissive: M8,
+    pub(super) glossy: GlossyLanes,
+    /// Albedo, tint, radiance or a glossy surface's diffuse part.
+    pub(super) color: V8,
+}
+
+/// Directions drawn at eight hits (`Bsdf::sample`).
+pub(crate) struct Scattered {
+    /// The lanes that scattered (the others' paths end).
+    pub(crate) go: M8,
+    /// Lanes whose draws are deltas (on mirrors and glass).
+    pub(crate) delta: M8,
+    pub(crate) wi: V8,
+    /// f · cos / pdf.
+    pub(crate) weight: V8,
+    pub(crate) pdf: F8,
+}
+
+impl<'a> LaneSurfaces<'a> {
+    /// `shape` indexes `surfaces` (lanes outside `alive` read any).
+    #[inline(always)]
+    pub(super) fn new(surfaces: &'a [Surface], shape: &[i32; LANES], alive: M8) -> Self {
+        let surface: [&Surface; LANES] = lanes::each(|i| &surfaces[shape[i] as usize]);
+        let code = F8::from_fn(|i| surface[i].kind);
+        let kind = |k: f32| code.eq(F8::splat(k)).and(alive);
+        LaneSurfaces {
+            lambert: kind(LAMBERT),
+            mirror: kind(MIRROR),
+            glass: kind(GLASS),
+            emissive: kind(EMITTER),
+            glossy: GlossyLanes::new(&surface, code, alive),
+            color: V8::from_fn(|i| surface[i].color),
+            surface,
+        }
+    }
+
+    /// `Bsdf::is_specular`: mirrors, glass, and what reflects nothing.
+    #[inline(always)]
+    pub(crate) fn specular(&self) -> M8 {
+        self.mirror.or(self.glass).or(self.emissive)
+    }
+
+    /// `Bsdf::sample` at each lane's surface, from the direction `wo`
+    /// toward where the path came from, the geometric `normal` and it
+    /// turned to `wo`'s side (`facing`).
+    #[inline(always)]
+    pub(crate) fn scatter(&self, rng: &mut Rng8, wo: V8, normal: V8, facing: V8, transport: Transport) -> Scattered {
+        let zero = F8::splat(0.0);
+        let mut wi = reflect_of(wo, facing);
+        let mut weight = self.color;
+        let mut pdf = F8::splat(1.0);
+        let mut go = self.mirror;
+        if self.lambert.any() {
+            let (u0, u1) = rng.next_2d(self.lambert);
+            let w = to_world(frame_from_z(facing), cosine_hemisphere_of(u0, u1));
+            let cos = w.dot(facing);
+            let ok = self.lambert.and(cos.gt(zero));
+            wi = ok.select_v(w, wi);
+            pdf = ok.select(cos.max(zero) * FRAC_1_PI, pdf);
+            go = go.or(ok);
+        }
+        let glossy = self.glossy.mask();
+        if glossy.any() {
+            let u_lobe = rng.next_f32(glossy);
+            let u = rng.next_2d(glossy);
+            let (ok, w, f_cos_over_pdf, p) = self.glossy.sample(wo, facing, u_lobe, u);
+            wi = ok.select_v(w, wi);
+            weight = ok.select_v(f_cos_over_pdf, weight);
+            pdf = ok.select(p, pdf);
+            go = go.or(ok);
+        }
+        if self.glass.any() {
+            let ior = F8::from_fn(|i| self.surface[i].ior);
+            let entering = wo.dot(normal).gt(zero);
+            let eta_i = entering.select(F8::splat(1.0), ior);
+            let eta_t = entering.select(ior, F8::splat(1.0));
+            let Refraction { fresnel, direction: refracted, eta, total } = refraction_of(wo, facing, eta_i, eta_t);
+            let u_lobe = rng.next_f32(self.glass.and_not(total));
+            let through = self.glass.and_not(total).and(u_lobe.ge(fresnel));
+            let bounced = self.glass.and_not(through);
+            // Radiance is compressed by η² entering a denser medium; power is not
+            let carried = match transport {
+                Transport::Radiance => self.color * (eta * eta),
+                Transport::Importance => self.color,
+            };
+            wi = through.select_v(refracted, wi);
+            weight = through.select_v(carried, weight);
+            pdf = through.select(1.0 - fresnel, bounced.select(fresnel, pdf));
+            go = go.or(self.glass);
+        }
+        Scattered { go, delta: self.specular(), wi, weight, pdf }
+    }
+}
