@@ -127,13 +127,18 @@ fn other_lights_bit_for_bit() {
     // in one batch of lanes
     glowing(&mut scene, "glow", Shape::Sphere { center: Vec3::new(60.0, 40.0, 100.0), radius: 4.0 });
     glowing(&mut scene, "panel", triangle([20.0, 70.0, 60.0], [40.0, 70.0, 60.0], [30.0, 70.0, 80.0]));
-    // A second of each kind of area light, so each kind is gathered lane by
-    // lane: another ball, another light through the ceiling (a cap), another
-    // triangle
+    // A second of each kind of area light, so each kind is one of two
+    // blended by lane: another ball, another light through the ceiling (a
+    // cap), another triangle
     glowing(&mut scene, "second glow", Shape::Sphere { center: Vec3::new(35.0, 55.0, 120.0), radius: 3.0 });
     glowing(&mut scene, "second cap", Shape::Sphere { center: Vec3::new(25.0, 681.0, 120.0), radius: 600.0 });
     glowing(&mut scene, "second panel", triangle([60.0, 75.0, 110.0], [80.0, 75.0, 110.0], [70.0, 75.0, 130.0]));
     assert_lanes_match_scalar(&scene, 32, 2);
+    // A third of each, so each kind is gathered lane by lane
+    glowing(&mut scene, "third glow", Shape::Sphere { center: Vec3::new(75.0, 30.0, 110.0), radius: 2.0 });
+    glowing(&mut scene, "third cap", Shape::Sphere { center: Vec3::new(75.0, 681.0, 50.0), radius: 600.0 });
+    glowing(&mut scene, "third panel", triangle([30.0, 60.0, 130.0], [50.0, 60.0, 130.0], [40.0, 60.0, 150.0]));
+    assert_lanes_match_scalar(&scene, 32, 1);
     scene.lights.push(light(LightKind::Directional { direction: Vec3::new(0.1, -1.0, 0.3) }, 1.0));
     assert_lanes_match_scalar(&scene, 32, 1);
 }

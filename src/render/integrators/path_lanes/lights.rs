@@ -167,29 +167,27 @@ pub(super) struct LaneLights {
     /// Whether every light is of one kind the lanes draw (then every lane
     /// draws that kind).
     one_kind: bool,
-    /// Of each kind, the index of the first light and whether it is the
-    /// only one (then it is splat rather than gathered lane by lane).
-    first: [Option<(usize, bool)>; 5],
+    /// Of each kind, its lights (their indices): one is splat, two are
+    /// blended, more are gathered lane by lane.
+    of_kind: [Vec<usize>; 5],
 }
 
 impl LaneLights {
     pub(super) fn new(world: &World) -> Self {
         let lights: Vec<_> = world.lights.iter().map(LaneLight::new).collect();
-        let first = |kind: fn(&LaneLight) -> bool| {
-            let mut of_kind = (0..lights.len()).filter(|&i| lights[i].as_ref().is_some_and(kind));
-            let first = of_kind.next()?;
-            Some((first, of_kind.next().is_none()))
+        let of_kind = |kind: fn(&LaneLight) -> bool| -> Vec<usize> {
+            (0..lights.len()).filter(|&i| lights[i].as_ref().is_some_and(kind)).collect()
         };
-        let first = [
-            first(|light| light.cap().is_some()),
-            first(|light| light.sphere().is_some()),
-            first(|light| light.triangle().is_some()),
-            first(|light| light.point().is_some()),
-            first(|light| light.directional().is_some()),
+        let of_kind = [
+            of_kind(|light| light.cap().is_some()),
+            of_kind(|light| light.sphere().is_some()),
+            of_kind(|light| light.triangle().is_some()),
+            of_kind(|light| light.point().is_some()),
+            of_kind(|light| light.directional().is_some()),
         ];
         LaneLights {
-            one_kind: lights.iter().all(Option::is_some) && first.iter().flatten().count() == 1,
-            first,
+            one_kind: lights.iter().all(Option::is_some) && of_kind.iter().filter(|k| !k.is_empty()).count() == 1,
+            of_kind,
             lights,
         }
     }
@@ -204,8 +202,8 @@ impl LaneLights {
         which: usize,
         kind: fn(&LaneLight) -> Option<&T>,
     ) -> Option<(M8, PerLane<'a, T>)> {
-        let (first, single) = self.first[which]?;
-        let first = self.lights[first].as_ref().and_then(kind)?;
+        let indices = &self.of_kind[which];
+        let first = self.lights[*indices.first()?].as_ref().and_then(kind)?;
         let lane_kind = |i: usize| self.lights[pick[i]].as_ref().and_then(kind);
         let lanes = match self.one_kind {
             true => mask,
@@ -214,21 +212,27 @@ impl LaneLights {
         if !lanes.any() {
             return None;
         }
+        // Lanes of another kind compute on the first light of this one, unused
         Some((
             lanes,
-            match single {
-                true => PerLane::One(first),
-                // Lanes of another kind compute on the first light of this one, unused
-                false => PerLane::Each(lanes::each(|i| lane_kind(i).unwrap_or(first))),
+            match indices[..] {
+                [_] => PerLane::One(first),
+                [_, second_index] => match self.lights[second_index].as_ref().and_then(kind) {
+                    Some(second) => PerLane::Two(first, second, M8::from_fn(|i| pick[i] == second_index)),
+                    None => PerLane::One(first),
+                },
+                _ => PerLane::Each(lanes::each(|i| lane_kind(i).unwrap_or(first))),
             },
         ))
     }
 }
 
-/// Each lane's light of one kind: the only light of its kind, splat, or
-/// each lane's own.
+/// Each lane's light of one kind: the only light of its kind, splat; one
+/// of two (the second in the lanes of the mask: a quad light's triangles),
+/// blended; or each lane's own, gathered.
 enum PerLane<'a, T> {
     One(&'a T),
+    Two(&'a T, &'a T, M8),
     Each([&'a T; LANES]),
 }
 
@@ -237,6 +241,7 @@ impl<T> PerLane<'_, T> {
     fn f8(&self, field: impl Fn(&T) -> f32) -> F8 {
         match self {
             PerLane::One(light) => F8::splat(field(light)),
+            PerLane::Two(first, second, lanes) => lanes.select(F8::splat(field(second)), F8::splat(field(first))),
             PerLane::Each(lights) => F8::from_fn(|i| field(lights[i])),
         }
     }
@@ -245,6 +250,7 @@ impl<T> PerLane<'_, T> {
     fn v8(&self, field: impl Fn(&T) -> Vec3) -> V8 {
         match self {
             PerLane::One(light) => V8::splat(field(light)),
+            PerLane::Two(first, second, lanes) => lanes.select_v(V8::splat(field(second)), V8::splat(field(first))),
             PerLane::Each(lights) => V8::from_fn(|i| field(lights[i])),
         }
     }

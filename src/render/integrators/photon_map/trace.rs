@@ -108,7 +108,7 @@ mod tests {
     use super::*;
     use crate::render::world::camera::CameraModel;
     use crate::render::world::World;
-    use crate::scene::{presets, Attenuation, Light, LightKind, Rgb, Scene, ValidScene};
+    use crate::scene::{presets, Attenuation, Light, LightKind, Object, Rgb, Scene, Shape, ValidScene};
 
     fn preset(name: &str) -> Scene {
         presets::preset(name).and_then(Result::ok).expect("preset").into_scene()
@@ -147,6 +147,52 @@ mod tests {
             let stored = assert_lanes_store_what_one_by_one_does(name, preset(name), 16);
             assert!(stored > 1000, "{name}: only {stored} photons stored");
         }
+    }
+
+    /// Lights of every kind the lanes emit from, one, two and three of a
+    /// kind (splat, blended, gathered lane by lane), beside spots, which
+    /// emit lane by lane: smallpt's room with balls, caps and triangles
+    /// glowing, and point lights and spots.
+    #[test]
+    fn every_kind_of_light_emits_the_same_photons() {
+        let mut scene = preset("smallpt");
+        let light = |name: &str, kind| Light {
+            name: name.into(),
+            kind,
+            color: Rgb::ONE,
+            intensity: 2000.0,
+            attenuation: Attenuation::default(),
+            enabled: true,
+        };
+        let glowing = |scene: &mut Scene, name: &str, shape| {
+            scene.objects.push(Object { name: name.into(), shape, ..scene.objects[8].clone() });
+        };
+        let panel = |x: f32, y: f32, z: f32| Shape::Triangle {
+            a: Vec3::new(x, y, z),
+            b: Vec3::new(x + 20.0, y, z),
+            c: Vec3::new(x + 10.0, y, z + 20.0),
+        };
+        let spot = |x: f32| LightKind::Spot {
+            position: Vec3::new(x, 70.0, 60.0),
+            direction: Vec3::new(0.0, -1.0, 0.2),
+            cone_angle_degrees: 30.0,
+            falloff_exponent: 4.0,
+        };
+        for (k, x) in [20.0f32, 45.0, 70.0].into_iter().enumerate() {
+            let stored = assert_lanes_store_what_one_by_one_does("smallpt and lights", scene.clone(), 16);
+            assert!(stored > 1000, "{k} of each kind: only {stored} photons stored");
+            glowing(&mut scene, &format!("glow {k}"), Shape::Sphere { center: Vec3::new(x, 30.0, 100.0), radius: 3.0 });
+            glowing(
+                &mut scene,
+                &format!("cap {k}"),
+                Shape::Sphere { center: Vec3::new(x, 681.0, 100.0), radius: 600.0 },
+            );
+            glowing(&mut scene, &format!("panel {k}"), panel(x, 70.0, 60.0));
+            scene.lights.push(light(&format!("point {k}"), LightKind::Point { position: Vec3::new(x, 60.0, 90.0) }));
+            scene.lights.push(light(&format!("spot {k}"), spot(x)));
+        }
+        let stored = assert_lanes_store_what_one_by_one_does("smallpt and lights", scene, 16);
+        assert!(stored > 1000, "three of each kind: only {stored} photons stored");
     }
 
     /// Photons that end at the depth cap, or before any bounce.
