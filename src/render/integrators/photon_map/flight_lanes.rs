@@ -1,9 +1,10 @@
-//! Photons eight at a time: each leaves its light as `Tracing::launch`
-//! sends it, one by one, then bounces in the lanes, as `Tracing::bounce`
-//! does (its map's rule for storing, the surfaces' scattering shared with
-//! the path tracer, Russian roulette at diffuse surfaces): the same photons
-//! bit for bit, stored in the order each photon meets its surfaces. A lane
-//! whose photon ends takes the next one.
+//! Photons eight at a time, as `Tracing::launch` and `Tracing::bounce`
+//! send them one at a time: eight leave their lights at once (the light
+//! each picks, lane by lane; where it leaves it, in the lanes), then bounce
+//! in the lanes (their map's rule for storing, the surfaces' scattering
+//! shared with the path tracer, Russian roulette at diffuse surfaces). The
+//! same photons bit for bit, each stored in the order its photon meets its
+//! surfaces. A lane whose photon ends takes the next one.
 
 use std::ops::Range;
 
@@ -28,6 +29,22 @@ struct PhotonLanes {
     rng: Rng8,
     /// Each lane's photon, by its place in the indices traced.
     place: [u32; LANES],
+}
+
+impl PhotonLanes {
+    /// Lanes `started` take photons that leave `origin` along `direction`
+    /// carrying `power`, their streams in `rng` (the other lanes' as they were).
+    #[inline(always)]
+    fn start(&mut self, started: M8, held: M8, origin: V8, direction: V8, power: V8, rng: Rng8) {
+        self.active = self.active.or(started);
+        self.held = started.select_mask(held, self.held);
+        self.origin = started.select_v(origin, self.origin);
+        self.direction = started.select_v(direction, self.direction);
+        self.power = started.select_v(power, self.power);
+        self.depth = self.depth.reset(started);
+        self.diffuse_bounces = self.diffuse_bounces.reset(started);
+        self.rng = rng;
+    }
 }
 
 impl Tracing<'_> {
@@ -122,14 +139,7 @@ impl Tracing<'_> {
             for lane in started.lanes() {
                 held |= (self.world().holds(emitted.origin.lane(lane)) as u32) << lane;
             }
-            st.active = st.active.or(started);
-            st.held = started.select_mask(M8::from_bits(held), st.held);
-            st.origin = started.select_v(emitted.origin, st.origin);
-            st.direction = started.select_v(emitted.direction, st.direction);
-            st.power = started.select_v(power, st.power);
-            st.depth = st.depth.reset(started);
-            st.diffuse_bounces = st.diffuse_bounces.reset(started);
-            st.rng = rng;
+            st.start(started, M8::from_bits(held), emitted.origin, emitted.direction, power, rng);
         }
     }
 
@@ -156,15 +166,10 @@ impl Tracing<'_> {
         if started == 0 {
             return;
         }
-        let started = M8::from_bits(started);
-        st.active = st.active.or(started);
-        st.held = started.select_mask(M8::from_fn(|i| held[i]), st.held);
-        st.origin = started.select_v(V8::from_fn(|i| origin[i]), st.origin);
-        st.direction = started.select_v(V8::from_fn(|i| direction[i]), st.direction);
-        st.power = started.select_v(V8::from_fn(|i| power[i]), st.power);
-        st.depth = st.depth.reset(started);
-        st.diffuse_bounces = st.diffuse_bounces.reset(started);
-        st.rng = Rng8::from_states(states);
+        let (origin, direction, power) =
+            (V8::from_fn(|i| origin[i]), V8::from_fn(|i| direction[i]), V8::from_fn(|i| power[i]));
+        let held = M8::from_fn(|i| held[i]);
+        st.start(M8::from_bits(started), held, origin, direction, power, Rng8::from_states(states));
     }
 
     /// `Tracing::bounce` for every photon in flight, at its ray's nearest
