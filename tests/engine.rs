@@ -186,10 +186,16 @@ fn a_render_that_never_ends_does_not_hold_back_another_on_the_same_workers() {
         }
     };
     assert_eq!(finished.map(|s| s.passes), Some(4), "the short render never finished");
-    assert!(
-        endless.events().try_iter().any(|e| matches!(e, RenderEvent::PassFinished { .. })),
-        "the endless one goes on"
-    );
+    // Waited for, not polled: a pass's event may still be on its way
+    // from the session's thread when the short render's end arrives
+    let goes_on = loop {
+        match endless.events().recv_timeout(Duration::from_secs(120)) {
+            Ok(RenderEvent::PassFinished { .. }) => break true,
+            Ok(_) => {}
+            Err(_) => break false,
+        }
+    };
+    assert!(goes_on, "the endless one goes on");
     drop(short);
     drop(endless);
 }
