@@ -8,7 +8,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::light_paths::LightVertex;
+use super::light_paths::LightPaths;
 use super::mis::Partials;
 use crate::render::integrators::photon_map::cells::PointGrid;
 use crate::scene::Rgb;
@@ -20,7 +20,7 @@ use crate::scene::Rgb;
 const MERGE_CELLS: f32 = 4.0;
 
 /// What a merge reads of a light vertex.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct MergeVertex {
     /// Toward the vertex before it (the way light came).
     pub wo: Vec3,
@@ -39,24 +39,33 @@ pub struct MergeGrid {
 }
 
 impl MergeGrid {
-    /// The grid of `vertices` for merges within `radius` (cells
+    /// The grid of `paths`' vertices for merges within `radius` (cells
     /// `MERGE_CELLS` radii wide).
-    pub fn build(vertices: &[LightVertex], radius: f32) -> Self {
+    pub fn build(paths: &LightPaths, radius: f32) -> Self {
         // The vertices read in sequence here, so that only small records
-        // are gathered in the grid's order
-        let (positions, merged): (Vec<Vec3>, Vec<MergeVertex>) = vertices
-            .par_iter()
-            .map(|v| {
-                let merged = MergeVertex {
+        // are gathered in the grid's order; each chunk into its own stretch
+        let count = paths.chunks.iter().map(|chunk| chunk.vertices.len()).sum();
+        let (mut positions, mut merged) = (vec![Vec3::ZERO; count], vec![MergeVertex::default(); count]);
+        let mut stretches = Vec::with_capacity(paths.chunks.len());
+        let (mut positions_left, mut merged_left) = (&mut positions[..], &mut merged[..]);
+        for chunk in &paths.chunks {
+            let (here, rest) = std::mem::take(&mut positions_left).split_at_mut(chunk.vertices.len());
+            let (merged_here, merged_rest) = std::mem::take(&mut merged_left).split_at_mut(chunk.vertices.len());
+            stretches.push((chunk, here, merged_here));
+            (positions_left, merged_left) = (rest, merged_rest);
+        }
+        stretches.into_par_iter().for_each(|(chunk, positions, merged)| {
+            for (v, (position, merged)) in chunk.vertices.iter().zip(positions.iter_mut().zip(merged)) {
+                *position = v.hit.point;
+                *merged = MergeVertex {
                     wo: v.wo,
                     length: v.length,
                     throughput: v.throughput,
                     continuation: v.bsdf.continuation(),
                     partials: v.partials,
                 };
-                (v.hit.point, merged)
-            })
-            .unzip();
+            }
+        });
         let points = PointGrid::build(&positions, |&p| p, radius * MERGE_CELLS);
         let vertices = points.in_grid_order(&merged);
         Self { points, vertices }

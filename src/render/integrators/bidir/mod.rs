@@ -187,7 +187,7 @@ impl Bidir {
         let keep_going = || observer.is_current();
         let paths = light_paths::trace(&ctx, pixels, pass as u64, self.seed, &keep_going)?;
         let radius = self.merge_radius(pass);
-        let grid = weighing.merge.then(|| MergeGrid::build(&paths.vertices, radius));
+        let grid = weighing.merge.then(|| MergeGrid::build(&paths, radius));
         if !observer.is_current() {
             return None;
         }
