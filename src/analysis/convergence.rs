@@ -34,6 +34,18 @@ impl ConvergenceLog {
         self.points.iter().find(|p| p.error.rel_mse <= threshold).map(|p| p.seconds)
     }
 
+    /// The first time after which relMSE stays at `threshold` or below to
+    /// the end of the run. A noisy curve can dip below once early on: to
+    /// say when one algorithm has another's error, `time_to_reach` would
+    /// answer too soon.
+    pub fn time_to_stay_within(&self, threshold: f64) -> Option<f64> {
+        let above = |p: &ConvergencePoint| p.error.rel_mse.is_nan() || p.error.rel_mse > threshold;
+        match self.points.iter().rposition(above) {
+            None => self.points.first().map(|p| p.seconds),
+            Some(above) => self.points.get(above + 1).map(|p| p.seconds),
+        }
+    }
+
     /// Least-squares slope of log error against log time over the second
     /// half of the run (the asymptotic regime): −1 for an unbiased Monte
     /// Carlo estimator, flattening toward 0 where bias dominates.
@@ -75,5 +87,32 @@ mod tests {
         assert_eq!(log.time_to_reach(0.01), Some(10.0));
         assert_eq!(log.time_to_reach(1e-6), None);
         assert_eq!(log.error_at(0.1), None);
+        assert_eq!(log.time_to_stay_within(0.01), Some(10.0));
+    }
+
+    /// A curve that dips to 0.1 at 1 s, rises, comes back at 4 s and
+    /// stays there but for a NaN at 6 s: reached at 1 s, stayed at from 7 s.
+    #[test]
+    fn staying_within_waits_for_the_last_rise() {
+        let log = ConvergenceLog {
+            points: [0.5, 0.09, 0.2, 0.15, 0.1, 0.08, f64::NAN, 0.05]
+                .iter()
+                .enumerate()
+                .map(|(i, &rel_mse)| ConvergencePoint {
+                    seconds: i as f64,
+                    samples_per_pixel: i as u32,
+                    rays: 0,
+                    error: ErrorEstimate { rel_mse, standard_error: 0.0, noise_floor: None },
+                    flip: None,
+                })
+                .collect(),
+        };
+        assert_eq!(log.time_to_reach(0.1), Some(1.0));
+        assert_eq!(log.time_to_stay_within(0.1), Some(7.0), "a NaN is not within");
+        let before_nan = ConvergenceLog { points: log.points[..6].to_vec() };
+        assert_eq!(before_nan.time_to_stay_within(0.1), Some(4.0));
+        assert_eq!(before_nan.time_to_stay_within(0.5), Some(0.0));
+        assert_eq!(log.time_to_stay_within(0.01), None);
+        assert_eq!(ConvergenceLog::default().time_to_stay_within(1.0), None);
     }
 }

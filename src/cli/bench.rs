@@ -269,6 +269,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             runs.push(run);
         }
         println!("{}", table(&runs, args.budget));
+        if let Some(reach) = against_path(&runs, args.budget) {
+            println!("{reach}");
+        }
         let series: Vec<(String, ConvergenceLog)> =
             runs.iter().map(|r| (r.algorithm.label().to_owned(), r.log.clone())).collect();
         let plot_path = args.out.join(format!("{name}.png"));
@@ -280,6 +283,24 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     fileio::write_bytes(&csv_path, csv.as_bytes())?;
     println!("\nCSV → {}", csv_path.display());
     Ok(())
+}
+
+/// When each algorithm has path tracing's error at the budget for good
+/// (`time_to_stay_within`), and how much sooner than path tracing; None
+/// without path tracing and another algorithm among `runs`.
+pub fn against_path(runs: &[Run], budget: f64) -> Option<String> {
+    let path = runs.iter().find(|run| run.algorithm == Algorithm::Path)?;
+    if runs.len() < 2 {
+        return None;
+    }
+    let target = path.log.error_at(budget).or(path.log.points.last().map(|p| p.error.rel_mse))?;
+    let mut out = format!("path tracing's relMSE at the budget, {}, held from:\n", format_error(Some(target)));
+    for run in runs.iter().filter(|run| run.algorithm != Algorithm::Path) {
+        let time = run.log.time_to_stay_within(target);
+        let sooner = time.filter(|&t| t > 0.0).map_or("—".into(), |t| format!("{:.2}×", budget / t));
+        let _ = writeln!(out, "{:<28} {:>10} {:>8}", run.algorithm.label(), format_time(time), sooner);
+    }
+    Some(out)
 }
 
 pub fn table(runs: &[Run], budget: f64) -> String {
@@ -317,4 +338,51 @@ pub fn table(runs: &[Run], budget: f64) -> String {
         );
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::metrics::ErrorEstimate;
+
+    fn run(algorithm: Algorithm, errors: &[f64]) -> Run {
+        let points = errors
+            .iter()
+            .enumerate()
+            .map(|(i, &rel_mse)| ConvergencePoint {
+                seconds: (i + 1) as f64,
+                samples_per_pixel: i as u32 + 1,
+                rays: 0,
+                error: ErrorEstimate { rel_mse, standard_error: 0.0, noise_floor: None },
+                flip: None,
+            })
+            .collect();
+        Run {
+            algorithm,
+            log: ConvergenceLog { points },
+            stats: PassStats::default(),
+            image: LinearImage { width: 0, height: 0, pixels: Vec::new() },
+        }
+    }
+
+    /// Path tracing ends its 4 s at 0.1; BDPT holds 0.1 from 3 s (1.33×
+    /// sooner) though it dipped there at 1 s; VCM never gets there.
+    #[test]
+    fn each_algorithm_is_timed_to_path_tracings_last_error() {
+        let runs = [
+            run(Algorithm::Bdpt, &[0.09, 0.2, 0.1, 0.05]),
+            run(Algorithm::Path, &[0.4, 0.3, 0.2, 0.1]),
+            run(Algorithm::Vcm, &[0.5, 0.4, 0.3, 0.2]),
+        ];
+        let text = against_path(&runs, 4.0).expect("path tracing is among the runs");
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 3, "{text}");
+        assert!(lines[0].contains("1.00e-1"), "{text}");
+        let bdpt: Vec<&str> = lines[1].split_whitespace().collect();
+        assert_eq!(bdpt[bdpt.len() - 3..], ["3.00", "s", "1.33×"], "{text}");
+        let vcm: Vec<&str> = lines[2].split_whitespace().collect();
+        assert!(lines[2].starts_with(Algorithm::Vcm.label()) && vcm.ends_with(&["—", "—"]), "{text}");
+        assert!(against_path(&runs[2..], 4.0).is_none(), "no path tracing");
+        assert!(against_path(&runs[1..2], 4.0).is_none(), "path tracing alone");
+    }
 }
