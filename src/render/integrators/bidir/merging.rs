@@ -36,16 +36,30 @@ pub struct MergeGrid {
     points: PointGrid,
     /// By slot in the grid's order.
     vertices: Vec<MergeVertex>,
+    /// The records in the vertices' order, kept for the next pass.
+    spare: Vec<MergeVertex>,
+}
+
+/// A grid's two record arrays, kept from pass to pass: above 32 MiB
+/// (VCM at 512×384) each was mapped afresh every pass and its pages
+/// faulted in again (`engine::heap`).
+#[derive(Default)]
+pub struct MergeBuffers {
+    by_vertex: Vec<MergeVertex>,
+    by_slot: Vec<MergeVertex>,
 }
 
 impl MergeGrid {
     /// The grid of `paths`' vertices for merges within `radius` (cells
-    /// `MERGE_CELLS` radii wide).
-    pub fn build(paths: &LightPaths, radius: f32) -> Self {
+    /// `MERGE_CELLS` radii wide), in `buffers`.
+    pub fn build(paths: &LightPaths, radius: f32, buffers: MergeBuffers) -> Self {
         // The vertices read in sequence here, so that only small records
         // are gathered in the grid's order; each chunk into its own stretch
         let count = paths.chunks.iter().map(|chunk| chunk.vertices.len()).sum();
-        let (mut positions, mut merged) = (vec![Vec3::ZERO; count], vec![MergeVertex::default(); count]);
+        let MergeBuffers { by_vertex: mut merged, by_slot: mut vertices } = buffers;
+        merged.clear();
+        merged.resize(count, MergeVertex::default());
+        let mut positions = vec![Vec3::ZERO; count];
         let mut stretches = Vec::with_capacity(paths.chunks.len());
         let (mut positions_left, mut merged_left) = (&mut positions[..], &mut merged[..]);
         for chunk in &paths.chunks {
@@ -67,8 +81,13 @@ impl MergeGrid {
             }
         });
         let points = PointGrid::build(&positions, |&p| p, radius * MERGE_CELLS);
-        let vertices = points.in_grid_order(&merged);
-        Self { points, vertices }
+        points.in_grid_order_into(&merged, &mut vertices);
+        Self { points, vertices, spare: merged }
+    }
+
+    /// Its record arrays, for the next pass's grid.
+    pub fn into_buffers(self) -> MergeBuffers {
+        MergeBuffers { by_vertex: self.spare, by_slot: self.vertices }
     }
 
     /// Every light vertex within `radius` of `point` (squared distance ≤

@@ -32,7 +32,7 @@ use crate::render::world::light::LightSource;
 use crate::render::world::World;
 use crate::scene::Rgb;
 use camera_paths::LightSide;
-use merging::MergeGrid;
+use merging::{MergeBuffers, MergeGrid};
 use mis::Strategies;
 use strategies::{Contribution, StrategyFilm};
 
@@ -73,6 +73,8 @@ pub struct Bidir {
     /// The world compiled for eight rays at a time, for the light subpaths'
     /// flights and every shadow ray.
     path_lanes: Option<Box<PathLanes>>,
+    /// The merge grid's records, from pass to pass.
+    merge_buffers: MergeBuffers,
 }
 
 /// What the subpaths of a pass share.
@@ -130,6 +132,7 @@ impl Bidir {
             picker: LightPicker::new(world),
             strategy_film: None,
             path_lanes: PathLanes::new(world).map(Box::new),
+            merge_buffers: MergeBuffers::default(),
         }
     }
 
@@ -187,7 +190,7 @@ impl Bidir {
         let keep_going = || observer.is_current();
         let paths = light_paths::trace(&ctx, pixels, pass as u64, self.seed, &keep_going)?;
         let radius = self.merge_radius(pass);
-        let grid = weighing.merge.then(|| MergeGrid::build(&paths, radius));
+        let grid = weighing.merge.then(|| MergeGrid::build(&paths, radius, std::mem::take(&mut self.merge_buffers)));
         if !observer.is_current() {
             return None;
         }
@@ -230,6 +233,9 @@ impl Bidir {
             }
         }
         self.strategy_film = strategy_film;
+        if let Some(grid) = grid {
+            self.merge_buffers = grid.into_buffers();
+        }
         // The joins to the camera, each accepted as a sample is
         let mut rejected = Counters::default();
         let splats: Vec<Vec<_>> = (paths.splats.iter())

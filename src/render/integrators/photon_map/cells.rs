@@ -162,16 +162,21 @@ impl PointGrid {
     /// slot k holds point `order[k]`'s, so a query reads its points' values
     /// in sequence, where by index each would be a cache miss.
     pub fn in_grid_order<T: Copy + Send + Sync>(&self, values: &[T]) -> Vec<T> {
+        let mut out = Vec::new();
+        self.in_grid_order_into(values, &mut out);
+        out
+    }
+
+    /// `in_grid_order` into `out`, replacing what it held (its memory kept).
+    pub fn in_grid_order_into<T: Copy + Send + Sync>(&self, values: &[T], out: &mut Vec<T>) {
         let order = &self.order;
-        (0..order.len())
-            .into_par_iter()
-            .map(|k| {
-                if let Some(&ahead) = order.get(k + PREFETCH_AHEAD) {
-                    prefetch(&values[ahead as usize]);
-                }
-                values[order[k] as usize]
-            })
-            .collect()
+        out.clear();
+        out.par_extend((0..order.len()).into_par_iter().map(|k| {
+            if let Some(&ahead) = order.get(k + PREFETCH_AHEAD) {
+                prefetch(&values[ahead as usize]);
+            }
+            values[order[k] as usize]
+        }));
     }
 
     /// Sorted point `i`'s position.
