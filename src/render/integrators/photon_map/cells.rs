@@ -4,7 +4,7 @@
 //! lists the buckets its radius box touches, each once, and tests their
 //! points eight at a time. SPPM's photon grid (`grid`) and VCM's merges
 //! (`bidir::merging`) keep what they read of each point beside the columns,
-//! in the same order (`in_grid_order`), so a query reads nothing out of
+//! in the same order (`in_grid_order_into`), so a query reads nothing out of
 //! sequence.
 //!
 //! Chosen over the kd-tree by measurement for both: an SPPM query finds
@@ -100,7 +100,7 @@ impl PointGrid {
     }
 
     /// `for_each_within`'s points, each named by its slot in the grid's
-    /// order (where `in_grid_order` put its values), not by its index.
+    /// order (where `in_grid_order_into` put its values), not by its index.
     pub fn for_each_slot_within(&self, point: Vec3, radius: f32, mut f: impl FnMut(usize)) {
         let Some(touched) = self.touched(point, radius) else { return };
         let bound = radius * radius;
@@ -163,16 +163,10 @@ impl PointGrid {
         }
     }
 
-    /// `values` (one per point, in the points' order) in the grid's order:
-    /// slot k holds point `order[k]`'s, so a query reads its points' values
-    /// in sequence, where by index each would be a cache miss.
-    pub fn in_grid_order<T: Copy + Send + Sync>(&self, values: &[T]) -> Vec<T> {
-        let mut out = Vec::new();
-        self.in_grid_order_into(values, &mut out);
-        out
-    }
-
-    /// `in_grid_order` into `out`, replacing what it held (its memory kept).
+    /// `values` (one per point, in the points' order) in the grid's order,
+    /// into `out` (its memory kept from pass to pass): slot k holds point
+    /// `order[k]`'s, so a query reads its points' values in sequence, where
+    /// by index each would be a cache miss.
     pub fn in_grid_order_into<T: Copy + Send + Sync>(&self, values: &[T], out: &mut Vec<T>) {
         let order = &self.order;
         out.clear();
@@ -385,14 +379,15 @@ pub(super) mod tests {
         }
     }
 
-    /// A query's slots name, through the values `in_grid_order` put there,
+    /// A query's slots name, through the values `in_grid_order_into` put there,
     /// the points its indices name, in the same order.
     #[test]
     fn slots_name_the_points_indices_name() {
         let points = scattered(3000, 2.0, 11);
         let grid = PointGrid::build(&points, |&p| p, 0.1);
-        let index_at = grid.in_grid_order(&(0..points.len() as u32).collect::<Vec<_>>());
-        let position_at = grid.in_grid_order(&points);
+        let (mut index_at, mut position_at) = (Vec::new(), Vec::new());
+        grid.in_grid_order_into(&(0..points.len() as u32).collect::<Vec<_>>(), &mut index_at);
+        grid.in_grid_order_into(&points, &mut position_at);
         let mut s = Sampler::new(2, 0, 11);
         let mut found = 0;
         for _ in 0..200 {
