@@ -1,13 +1,15 @@
 //! Items that fly from hit to hit on their own (photons, light and camera
 //! subpaths), eight at a time: their rays meet the world in the paths'
-//! eight-lane hit loop (`PathLanes::intersect8`), and each goes on from its
+//! eight-lane hit loop (`PathLanes::lane_hits`), and each goes on from its
 //! hit by itself, in scalar code. A lane whose item ends takes the next
 //! one, so the lanes stay busy however far items go; items end out of
 //! turn, so what they make is tagged with their place for `reorder`.
+//! Items that sample a light and scatter at their hits may draw those in
+//! the lanes too (`DrawAtHits`).
 
 use std::ops::Range;
 
-use super::path_lanes::PathLanes;
+use super::path_lanes::{Given, PathLanes, Want};
 use crate::geometry::Ray;
 use crate::render::world::lanes::{self, LANES};
 use crate::render::world::{Hit, World};
@@ -27,7 +29,45 @@ pub fn fly<T>(
     indices: Range<u64>,
     launch: impl FnMut(u64) -> Option<T>,
     ray: impl FnMut(&T) -> (Ray, bool),
-    bounce: impl FnMut(u32, &mut T, Option<&Hit>) -> bool,
+    mut bounce: impl FnMut(u32, &mut T, Option<&Hit>) -> bool,
+) {
+    let bounce = move |place, item: &mut T, hit: Option<&Hit>, _: Option<&Given>| bounce(place, item, hit);
+    fly_drawing(path_lanes, world, indices, launch, ray, NoDraws, bounce)
+}
+
+/// What items draw at their hits in the lanes (`PathLanes::draw_at_hits`),
+/// handed to their `bounce`; one at a time they draw alone, in `bounce`.
+pub(crate) trait DrawAtHits<T> {
+    /// What `item` asks to draw at its next hit (None: nothing), asked
+    /// before its ray is traced.
+    fn want(&self, item: &T) -> Option<Want>;
+    /// The light chosen by a uniform number (`LightPicker::pick`).
+    fn pick(&self, u: f32) -> Option<(usize, f32)>;
+}
+
+/// Items that draw nothing in the lanes.
+pub(crate) struct NoDraws;
+
+impl<T> DrawAtHits<T> for NoDraws {
+    fn want(&self, _: &T) -> Option<Want> {
+        None
+    }
+
+    fn pick(&self, _: f32) -> Option<(usize, f32)> {
+        None
+    }
+}
+
+/// `fly`, with what `draws` asks for drawn in the lanes and handed to
+/// `bounce` (None: the item draws alone).
+pub(crate) fn fly_drawing<T>(
+    path_lanes: Option<&PathLanes>,
+    world: &World,
+    indices: Range<u64>,
+    launch: impl FnMut(u64) -> Option<T>,
+    ray: impl FnMut(&T) -> (Ray, bool),
+    draws: impl DrawAtHits<T>,
+    bounce: impl FnMut(u32, &mut T, Option<&Hit>, Option<&Given>) -> bool,
 ) {
     let Some(path_lanes) = path_lanes.filter(|_| PathLanes::runs_in_lanes()) else {
         return fly_one_at_a_time(world, indices, launch, ray, bounce);
@@ -35,9 +75,9 @@ pub fn fly<T>(
     #[cfg(target_arch = "x86_64")]
     // SAFETY: the CPU has AVX2 (`runs_in_lanes`).
     #[allow(unsafe_code)]
-    return unsafe { fly_avx2(path_lanes, world, indices, launch, ray, bounce) };
+    return unsafe { fly_avx2(path_lanes, world, indices, launch, ray, draws, bounce) };
     #[cfg(not(target_arch = "x86_64"))]
-    fly_lanes(path_lanes, world, indices, launch, ray, bounce)
+    fly_lanes(path_lanes, world, indices, launch, ray, draws, bounce)
 }
 
 fn fly_one_at_a_time<T>(
@@ -45,7 +85,7 @@ fn fly_one_at_a_time<T>(
     indices: Range<u64>,
     mut launch: impl FnMut(u64) -> Option<T>,
     mut ray: impl FnMut(&T) -> (Ray, bool),
-    mut bounce: impl FnMut(u32, &mut T, Option<&Hit>) -> bool,
+    mut bounce: impl FnMut(u32, &mut T, Option<&Hit>, Option<&Given>) -> bool,
 ) {
     for index in indices.clone() {
         let Some(mut item) = launch(index) else { continue };
@@ -53,7 +93,7 @@ fn fly_one_at_a_time<T>(
         loop {
             let (next, held) = ray(&item);
             let hit = world.intersect_held(&next, f32::INFINITY, held);
-            if !bounce(place, &mut item, hit.as_ref()) || hit.is_none() {
+            if !bounce(place, &mut item, hit.as_ref(), None) || hit.is_none() {
                 break;
             }
         }
@@ -68,9 +108,10 @@ fn fly_avx2<T>(
     indices: Range<u64>,
     launch: impl FnMut(u64) -> Option<T>,
     ray: impl FnMut(&T) -> (Ray, bool),
-    bounce: impl FnMut(u32, &mut T, Option<&Hit>) -> bool,
+    draws: impl DrawAtHits<T>,
+    bounce: impl FnMut(u32, &mut T, Option<&Hit>, Option<&Given>) -> bool,
 ) {
-    fly_lanes(path_lanes, world, indices, launch, ray, bounce)
+    fly_lanes(path_lanes, world, indices, launch, ray, draws, bounce)
 }
 
 #[inline(always)]
@@ -80,9 +121,11 @@ fn fly_lanes<T>(
     indices: Range<u64>,
     mut launch: impl FnMut(u64) -> Option<T>,
     mut ray: impl FnMut(&T) -> (Ray, bool),
-    mut bounce: impl FnMut(u32, &mut T, Option<&Hit>) -> bool,
+    draws: impl DrawAtHits<T>,
+    mut bounce: impl FnMut(u32, &mut T, Option<&Hit>, Option<&Given>) -> bool,
 ) {
     let mut flying: [Option<(u32, T)>; LANES] = Default::default();
+    let mut given: [Option<Given>; LANES] = [None; LANES];
     let mut next = indices.start;
     loop {
         for slot in flying.iter_mut().filter(|f| f.is_none()) {
@@ -95,10 +138,17 @@ fn fly_lanes<T>(
             return;
         }
         let rays = lanes::each(|i| flying[i].as_ref().map(|(_, item)| ray(item)));
-        let hits = path_lanes.intersect8(world, &rays);
-        for (slot, hit) in flying.iter_mut().zip(&hits) {
+        let wants = lanes::each(|i| flying[i].as_ref().and_then(|(_, item)| draws.want(item)));
+        let (lane_hits, direction) = path_lanes.lane_hits(&rays);
+        let drawn = wants.iter().any(Option::is_some);
+        if drawn {
+            path_lanes.draw_at_hits(world, &lane_hits, direction, &wants, &|u| draws.pick(u), &mut given);
+        }
+        let hits = path_lanes.hits_of(world, &lane_hits);
+        for ((slot, hit), given) in flying.iter_mut().zip(&hits).zip(&given) {
             let Some((place, item)) = slot else { continue };
-            if !bounce(*place, item, hit.as_ref()) || hit.is_none() {
+            let given = given.as_ref().filter(|_| drawn);
+            if !bounce(*place, item, hit.as_ref(), given) || hit.is_none() {
                 *slot = None;
             }
         }

@@ -61,6 +61,12 @@ impl Sampler {
         self.state
     }
 
+    /// The stream at `state`, as `state` gave it (for streams that drew
+    /// in SIMD lanes).
+    pub(crate) fn from_state(state: u64) -> Self {
+        Sampler { state }
+    }
+
     /// Uniform in [0, 1): 24 random bits, so 1.0 is never returned.
     #[inline]
     pub fn next_f32(&mut self) -> f32 {

@@ -21,12 +21,14 @@ use super::mis::{self, Partials};
 use super::strategies::{Contribution, NoTally, PixelTally, Strategy, Tally};
 use super::Context;
 use crate::geometry::Ray;
+use crate::render::integrators::flying::{self, DrawAtHits};
 use crate::render::integrators::next_event::PathScope;
+use crate::render::integrators::path_lanes::{Before, Given, PickedLight, Want};
 use crate::render::integrators::shadow_batch::ShadowBatch;
-use crate::render::integrators::{flying, reorder, Counters};
+use crate::render::integrators::{reorder, Counters};
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::camera::CameraTile;
-use crate::render::world::light::{LightSample, LightSource};
+use crate::render::world::light::LightSource;
 use crate::render::world::occluders::Shadow;
 use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::uniform_sphere_pdf;
@@ -147,6 +149,25 @@ struct CameraPath<'w> {
     found: Found,
 }
 
+/// Camera subpaths draw their light samples and directions in the lanes
+/// where they can: at every vertex that may go on.
+struct CameraDraws<'c> {
+    ctx: &'c Context<'c>,
+}
+
+impl DrawAtHits<CameraPath<'_>> for CameraDraws<'_> {
+    fn want(&self, path: &CameraPath) -> Option<Want> {
+        let ctx = self.ctx;
+        let goes_on = !ctx.light_tracing && path.length < ctx.max_length;
+        let before = if ctx.strategies.connect { Before::Light } else { Before::Nothing };
+        goes_on.then(|| Want { state: path.sampler.state(), before })
+    }
+
+    fn pick(&self, u: f32) -> Option<(usize, f32)> {
+        self.ctx.picker.pick(u)
+    }
+}
+
 /// The light of every camera sample of `tile` (of a film `width` wide),
 /// into `out`; what each strategy brought, for the strategy view, into
 /// `contributions` in the order of the samples.
@@ -203,8 +224,8 @@ pub fn trace(
         }
         ended.shadows.clear();
     };
-    let bounce = |place: u32, path: &mut CameraPath, hit: Option<&Hit>| {
-        if path.bounce(ctx, light, hit, counters) {
+    let bounce = |place: u32, path: &mut CameraPath, hit: Option<&Hit>, drawn: Option<&Given>| {
+        if path.bounce(ctx, light, hit, drawn, counters) {
             return true;
         }
         let mut found = std::mem::take(&mut path.found);
@@ -215,7 +236,8 @@ pub fn trace(
         }
         false
     };
-    flying::fly(ctx.path_lanes, ctx.world, 0..count as u64, launch, ray, bounce);
+    let draws = CameraDraws { ctx };
+    flying::fly_drawing(ctx.path_lanes, ctx.world, 0..count as u64, launch, ray, draws, bounce);
     finish(&mut ended, contributions);
     counters.rays += rays;
     if !places.is_empty() {
@@ -227,9 +249,16 @@ pub fn trace(
 
 impl CameraPath<'_> {
     /// The path's vertex at `hit`, the nearest along its ray (None: it
-    /// left the scene): what it finds there, then its next ray. False once
-    /// the path ends.
-    fn bounce(&mut self, ctx: &Context, light: &LightSide, hit: Option<&Hit>, counters: &mut Counters) -> bool {
+    /// left the scene): what it finds there, then its next ray, from what
+    /// it `drawn` there in the lanes if it did. False once the path ends.
+    fn bounce(
+        &mut self,
+        ctx: &Context,
+        light: &LightSide,
+        hit: Option<&Hit>,
+        drawn: Option<&Given>,
+        counters: &mut Counters,
+    ) -> bool {
         let (world, s) = (ctx.world, &ctx.strategies);
         let length = self.length;
         let throughput = self.throughput;
@@ -262,7 +291,11 @@ impl CameraPath<'_> {
         if !bsdf.is_specular() {
             let vertex = CameraVertex { hit, wo, facing, bsdf: &bsdf, partials: &self.partials, length };
             if s.connect {
-                let part = direct(ctx, &self.scope, &vertex, sampler, counters);
+                let picked = match drawn {
+                    Some(given) => given.light,
+                    None => draw_light(ctx, hit, sampler),
+                };
+                let part = direct(ctx, &self.scope, &vertex, picked, counters);
                 let strategy = Strategy::Connect { length: length + 1, light_vertices: 1 };
                 self.found.shadowed(strategy, throughput, part);
                 for light_vertex in light.paths.path(self.pixel) {
@@ -282,7 +315,14 @@ impl CameraPath<'_> {
                 self.found.seen(None, true, sum, 0.0);
             }
         }
-        let Some(scattered) = bsdf.sample(wo, n, sampler, Transport::Radiance) else { return false };
+        let scattered = match drawn {
+            Some(given) => {
+                *sampler = Sampler::from_state(given.state);
+                given.scattered
+            }
+            None => bsdf.sample(wo, n, sampler, Transport::Radiance),
+        };
+        let Some(scattered) = scattered else { return false };
         let go_on = bsdf.continuation();
         if sampler.next_f32() >= go_on {
             return false;
@@ -355,21 +395,32 @@ fn background_weight(
     mis::hit_light(&ctx.strategies, partials, direct, emission)
 }
 
-/// Next-event estimation (s = 1): a light chosen by power, a sample of it;
+/// A light chosen by power for next-event estimation at `hit`, and a
+/// sample of it: as `PathLanes::draw_at_hits` draws it in the lanes.
+fn draw_light(ctx: &Context, hit: &Hit, sampler: &mut Sampler) -> Option<PickedLight> {
+    let (index, pick) = ctx.picker.pick(sampler.next_f32())?;
+    Some((index, pick, ctx.world.lights[index].sample(&hit.surface, sampler.next_2d())))
+}
+
+/// Next-event estimation (s = 1) from the light `picked` and its sample:
 /// its contribution and MIS weight, and the shadow ray that decides them.
 fn direct(
     ctx: &Context,
     scope: &PathScope,
     vertex: &CameraVertex,
-    sampler: &mut Sampler,
+    picked: Option<PickedLight>,
     counters: &mut Counters,
 ) -> Option<(Rgb, f32, Shadow)> {
-    let (index, pick) = ctx.picker.pick(sampler.next_f32())?;
+    let (index, pick, sample) = picked?;
     let light = &ctx.world.lights[index];
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
-    let shade = |sample: &LightSample| Some(bsdf.eval_pdf(wo, sample.wi, facing)).filter(|(f, _)| *f != Rgb::ZERO);
     counters.connections += 1;
-    let (sample, (f, pdf)) = scope.unshadowed_light_sample(light, vertex.hit, sampler.next_2d(), counters, shade)?;
+    let sample = sample?;
+    let (f, pdf) = bsdf.eval_pdf(wo, sample.wi, facing);
+    if f == Rgb::ZERO {
+        return None;
+    }
+    counters.rays += 1;
     let point = vertex.hit.surface.point;
     let (direct_pdf, cos_at_light) = match light {
         LightSource::Point { .. } | LightSource::Spot { .. } => ((sample.point - point).length_squared(), 1.0),

@@ -10,7 +10,7 @@
 
 use std::ops::Range;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::mis::{self, Partials};
@@ -18,10 +18,11 @@ use super::strategies::{Contribution, PixelTally, Strategy};
 use super::Context;
 use crate::geometry::{Ray, SurfaceHit};
 use crate::render::film::Splat;
+use crate::render::integrators::flying::{self, DrawAtHits};
 use crate::render::integrators::next_event::PathScope;
-use crate::render::integrators::path_lanes::PathLanes;
+use crate::render::integrators::path_lanes::{Before, Given, PathLanes, Want};
 use crate::render::integrators::shadow_batch::ShadowBatch;
-use crate::render::integrators::{flying, reorder, Counters};
+use crate::render::integrators::{reorder, Counters};
 use crate::render::world::bsdf::{Bsdf, Transport};
 use crate::render::world::light::LightSource;
 use crate::render::world::occluders::Shadow;
@@ -203,6 +204,25 @@ struct Flight<'w> {
     length: u32,
 }
 
+/// Light subpaths draw their lens samples and directions in the lanes
+/// where they can: at every vertex that may scatter.
+struct LightDraws<'c, 'w> {
+    ctx: &'c Context<'w>,
+}
+
+impl DrawAtHits<Flight<'_>> for LightDraws<'_, '_> {
+    fn want(&self, path: &Flight) -> Option<Want> {
+        let ctx = self.ctx;
+        let joins = (ctx.strategies.connect || ctx.light_tracing) && ctx.camera.has_lens();
+        let before = if joins { Before::Lens } else { Before::Nothing };
+        (path.length + 2 <= ctx.max_length).then(|| Want { state: path.sampler.state(), before })
+    }
+
+    fn pick(&self, u: f32) -> Option<(usize, f32)> {
+        self.ctx.picker.pick(u)
+    }
+}
+
 /// The light subpaths of one pass.
 struct Flights<'c, 'w> {
     ctx: &'c Context<'w>,
@@ -237,9 +257,9 @@ impl<'w> Flights<'_, 'w> {
     }
 
     /// The path's vertex at `hit`, the nearest along its ray: kept and
-    /// joined to the camera unless specular, then scattered. False once
-    /// the path ends.
-    fn bounce(&self, place: u32, path: &mut Flight, hit: &Hit, out: &mut ChunkPaths) -> bool {
+    /// joined to the camera unless specular, then scattered, from what it
+    /// `drawn` there in the lanes if it did. False once the path ends.
+    fn bounce(&self, place: u32, path: &mut Flight, hit: &Hit, drawn: Option<&Given>, out: &mut ChunkPaths) -> bool {
         let ctx = self.ctx;
         let (world, s) = (ctx.world, &ctx.strategies);
         let (light, pick, length) = (path.light, path.pick, path.length);
@@ -260,14 +280,26 @@ impl<'w> Flights<'_, 'w> {
                 out.vertices.push(vertex);
             }
             if s.connect || ctx.light_tracing {
-                join_camera(ctx, &path.scope, &vertex, sampler, place, out);
+                let lens = match drawn {
+                    Some(given) => given.lens.unwrap_or(Vec2::ZERO),
+                    None if ctx.camera.has_lens() => sampler.next_2d(),
+                    None => Vec2::ZERO,
+                };
+                join_camera(ctx, &path.scope, &vertex, lens, place, out);
             }
         }
         // A longer path would have no strategy left to finish it
         if length + 2 > ctx.max_length {
             return false;
         }
-        let Some(scattered) = bsdf.sample(wo, n, sampler, Transport::Importance) else { return false };
+        let scattered = match drawn {
+            Some(given) => {
+                *sampler = Sampler::from_state(given.state);
+                given.scattered
+            }
+            None => bsdf.sample(wo, n, sampler, Transport::Importance),
+        };
+        let Some(scattered) = scattered else { return false };
         let go_on = bsdf.continuation();
         if sampler.next_f32() >= go_on {
             return false;
@@ -296,9 +328,9 @@ impl<'w> Flights<'_, 'w> {
             rays += 1;
             (path.ray, path.scope.held)
         };
-        let bounce = |place, path: &mut Flight, hit: Option<&Hit>| {
+        let bounce = |place, path: &mut Flight, hit: Option<&Hit>, drawn: Option<&Given>| {
             let Some(hit) = hit else { return false };
-            let goes_on = self.bounce(place, path, hit, &mut out);
+            let goes_on = self.bounce(place, path, hit, drawn, &mut out);
             places.resize(out.vertices.len(), place);
             if out.joins.waiting.len() >= JOINS {
                 out.trace_joins(self.ctx);
@@ -306,7 +338,8 @@ impl<'w> Flights<'_, 'w> {
             goes_on
         };
         let count = (indices.end - indices.start) as usize;
-        flying::fly(path_lanes, self.ctx.world, indices, |index| self.launch(index), ray, bounce);
+        let (world, draws) = (self.ctx.world, LightDraws { ctx: self.ctx });
+        flying::fly_drawing(path_lanes, world, indices, |index| self.launch(index), ray, draws, bounce);
         out.counters.rays += rays;
         out.trace_joins(self.ctx);
         (out.vertices, out.ends) = reorder::by_item(&out.vertices, &places, count);
@@ -316,19 +349,11 @@ impl<'w> Flights<'_, 'w> {
     }
 }
 
-/// A light vertex joined to the camera (t = 1): a splat on the pixel it
-/// lands on, weighed against every other strategy for the same path
+/// A light vertex joined to the camera (t = 1) through `lens` (a point on
+/// the lens, if it has one): a splat on the pixel it lands on, weighed against every other strategy for the same path
 /// (plain light tracing weighs it 1: it is the only one it has), once its
 /// shadow ray, traced with others (`ChunkPaths::trace_joins`), gets through.
-fn join_camera(
-    ctx: &Context,
-    scope: &PathScope,
-    vertex: &LightVertex,
-    sampler: &mut Sampler,
-    place: u32,
-    out: &mut ChunkPaths,
-) {
-    let lens = if ctx.camera.has_lens() { sampler.next_2d() } else { glam::Vec2::ZERO };
+fn join_camera(ctx: &Context, scope: &PathScope, vertex: &LightVertex, lens: Vec2, place: u32, out: &mut ChunkPaths) {
     let Some(seen) = ctx.camera.connect(vertex.hit.point, lens) else { return };
     let facing = vertex.facing();
     let f = vertex.bsdf.eval(vertex.wo, seen.to_camera, facing);
@@ -372,9 +397,10 @@ mod tests {
     use crate::render::settings::MisHeuristic;
     use crate::render::world::camera::CameraModel;
     use crate::render::world::World;
-    use crate::scene::presets;
+    use crate::scene::{presets, Camera};
 
-    /// Every preset, and each way the light subpaths are used (light
+    /// Every preset, through a pinhole and a lens, and each way the light
+    /// subpaths are used (light
     /// tracing, connecting, merging, both; the strategy view open or not;
     /// paths of two segments at most and of eight):
     /// eight at a time, their shadow rays eight at a time, the paths make
@@ -385,9 +411,13 @@ mod tests {
         assert!(PathLanes::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
         let (width, height) = (48, 36);
         let film = StrategyFilm::new(width, height);
-        for name in presets::names() {
+        // Each preset through its pinhole and through a lens, whose
+        // samples light paths draw before they scatter
+        let lenses = presets::names().flat_map(|name| [(name, 0.0), (name, 0.05)]);
+        for (name, aperture_radius) in lenses {
             let scene = presets::preset(name).and_then(Result::ok).expect("preset");
-            let camera = CameraModel::new(&scene.camera, width, height);
+            let camera = CameraModel::new(&Camera { aperture_radius, ..scene.camera.clone() }, width, height);
+            assert_eq!(camera.has_lens(), aperture_radius > 0.0);
             let (world, visible_radius) = World::for_view(&scene, &camera, width, height);
             let path_lanes = PathLanes::new(&world).expect("a world the lanes trace");
             let picker = LightPicker::new(&world);
@@ -416,7 +446,9 @@ mod tests {
                     let one = Flights { ctx: &scalar_ctx, pass: 3, seed: 11 }.trace(None, indices.clone());
                     let eight = Flights { ctx: &lanes_ctx, pass: 3, seed: 11 }.trace(Some(&path_lanes), indices);
                     let view = strategy_film.is_some();
-                    let what = format!("{name}, connect {connect}, merge {merge}, view {view}, {max_length} segments");
+                    let what = format!(
+                        "{name}, lens {aperture_radius}, connect {connect}, merge {merge}, view {view}, {max_length} segments"
+                    );
                     let vertex_bits = |paths: &ChunkPaths| format!("{:?}", paths.vertices);
                     assert!(vertex_bits(&one) == vertex_bits(&eight), "{what}: the vertices differ");
                     assert_eq!(one.ends, eight.ends, "{what}");

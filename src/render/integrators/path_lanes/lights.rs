@@ -369,12 +369,18 @@ pub(super) struct LightLanes {
     pub(super) pdf: F8,
     pub(super) origin: V8,
     pub(super) t_max: F8,
+    /// The point drawn and the light's normal there (`LightSample::point`
+    /// and `normal`): what bidirectional methods weigh a sample by.
+    pub(super) point: V8,
+    pub(super) light_normal: V8,
 }
 
 impl LightLanes {
-    /// A delta light's samples in the lanes of `lanes`, `valid` those it lights.
+    /// A delta light's samples in the lanes of `lanes`, `valid` those it
+    /// lights, from `point` (the origin for a directional light).
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn set(&mut self, lanes: M8, valid: M8, wi: V8, value: V8, origin: V8, t_max: F8) {
+    fn set(&mut self, lanes: M8, valid: M8, wi: V8, value: V8, origin: V8, t_max: F8, point: V8) {
         self.valid = lanes.select_mask(valid, self.valid);
         self.delta = self.delta.or(lanes);
         self.wi = lanes.select_v(wi, self.wi);
@@ -382,6 +388,8 @@ impl LightLanes {
         self.pdf = lanes.select(F8::splat(f32::INFINITY), self.pdf);
         self.origin = lanes.select_v(origin, self.origin);
         self.t_max = lanes.select(t_max, self.t_max);
+        self.point = lanes.select_v(point, self.point);
+        self.light_normal = lanes.select_v(V8::splat(Vec3::ZERO), self.light_normal);
     }
 
     /// `LightSource::sample` for each lane's light: all but the background
@@ -407,6 +415,8 @@ impl LightLanes {
             pdf: F8::splat(0.0),
             origin: point,
             t_max: F8::splat(0.0),
+            point: V8::splat(Vec3::ZERO),
+            light_normal: V8::splat(Vec3::ZERO),
         };
         let (mut drawn, mut in_lanes) = (None, M8::NONE);
         if let Some((lanes, caps)) = lights.of_kind(pick, mask, 0, LaneLight::cap) {
@@ -427,7 +437,8 @@ impl LightLanes {
             // Emission is one-sided: the light's front must face the point
             let faces = !light_normal.dot(-wi).le(F8::splat(0.0));
             let valid = in_lanes.and(pdf.gt(F8::splat(0.0))).and(faces);
-            out = LightLanes { valid, delta: M8::NONE, wi, value: radiance / pdf, pdf, origin, t_max };
+            let value = radiance / pdf;
+            out = LightLanes { valid, delta: M8::NONE, wi, value, pdf, origin, t_max, point: target, light_normal };
         }
         if let Some((lanes, points)) = lights.of_kind(pick, mask, 3, LaneLight::point) {
             let position = points.v8(|light| light.position);
@@ -443,14 +454,14 @@ impl LightLanes {
             let spot = cos.lt(points.f8(|light| light.cos_cone)).select(F8::splat(0.0), cos.powf(exponent));
             let value = points.v8(|light| light.intensity) * (attenuation * spot);
             let valid = lanes.and_not(spot.eq(F8::splat(0.0)));
-            out.set(lanes, valid, wi, value, origin, t_max);
+            out.set(lanes, valid, wi, value, origin, t_max, position);
             in_lanes = in_lanes.or(lanes);
         }
         if let Some((lanes, directionals)) = lights.of_kind(pick, mask, 4, LaneLight::directional) {
             let wi = -directionals.v8(|light| light.direction);
             let origin = offset_origin(point, error, normal, wi);
             let value = directionals.v8(|light| light.irradiance);
-            out.set(lanes, lanes, wi, value, origin, F8::splat(f32::INFINITY));
+            out.set(lanes, lanes, wi, value, origin, F8::splat(f32::INFINITY), V8::splat(Vec3::ZERO));
             in_lanes = in_lanes.or(lanes);
         }
         let others = mask.and_not(in_lanes);
@@ -465,6 +476,8 @@ impl LightLanes {
                 out.pdf.set_lane(lane, sample.pdf);
                 out.origin.set_lane(lane, sample.shadow.origin);
                 out.t_max.set_lane(lane, sample.shadow_t_max);
+                out.point.set_lane(lane, sample.point);
+                out.light_normal.set_lane(lane, sample.normal);
             }
         }
         out

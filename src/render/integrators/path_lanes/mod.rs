@@ -15,11 +15,13 @@ use std::f32::consts::FRAC_1_PI;
 
 use glam::Vec3;
 
+mod draws;
 mod glossy;
 mod lights;
 mod samples;
 mod scatter;
 
+pub(crate) use draws::{Before, Given, PickedLight, Want};
 pub(crate) use lights::EmittedLanes;
 use lights::{LaneLights, LightLanes};
 use samples::{CameraSample, CameraSamples};
@@ -256,18 +258,24 @@ impl PathLanes {
     }
 
     /// The nearest hits of up to eight rays, each `held` or not as
-    /// `World::intersect_held` takes it: that function's hits, bit for bit,
-    /// from the paths' hit loop, for callers that go on lane by lane
-    /// (photons and light subpaths, `flying`). Fast only inlined into code
+    /// `World::intersect_held` takes it, still in the lanes (`hits_of`
+    /// gives them lane by lane: that function's hits, bit for bit), and the
+    /// rays' directions; for callers that go on lane by lane (photons,
+    /// light and camera subpaths, `flying`). Fast only inlined into code
     /// built for AVX2.
     #[inline(always)]
-    pub(crate) fn intersect8(&self, world: &World, rays: &[Option<(Ray, bool)>; LANES]) -> [Option<Hit>; LANES] {
+    pub(crate) fn lane_hits(&self, rays: &[Option<(Ray, bool)>; LANES]) -> (LaneHits, V8) {
         let active = M8::from_fn(|i| rays[i].is_some());
         let held = M8::from_fn(|i| rays[i].is_some_and(|(_, held)| held));
         let ray = |i: usize| rays[i].map_or(Ray::new(Vec3::ZERO, Vec3::Z), |(ray, _)| ray);
         let origin = V8::from_fn(|i| ray(i).origin);
         let direction = V8::from_fn(|i| ray(i).direction);
-        let hits = self.nearest(active, held, origin, direction);
+        (self.nearest(active, held, origin, direction), direction)
+    }
+
+    /// `lane_hits`' hits lane by lane, as `World::intersect_held` gives them.
+    #[inline(always)]
+    pub(crate) fn hits_of(&self, world: &World, hits: &LaneHits) -> [Option<Hit>; LANES] {
         // Out of the registers first: the closure below does not inherit AVX2
         let found = hits.found.bits();
         let t = hits.t.to_array();

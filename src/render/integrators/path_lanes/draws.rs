@@ -1,0 +1,200 @@
+//! What items flying eight at a time (`flying`) draw at their hits, in the
+//! lanes: at a surface that is not specular, a light sample for next-event
+//! estimation and a scattered direction (`LightSource::sample` and
+//! `Bsdf::sample`), from each item's own stream in the order the scalar
+//! code draws them, so the items go on as if they had drawn them alone.
+
+use glam::{Vec2, Vec3};
+
+use super::lights::LightLanes;
+use super::{LaneHits, LaneSurfaces, PathLanes, Scattered};
+use crate::geometry::{Ray, SurfaceHit};
+use crate::render::world::bsdf::{BsdfSample, Transport};
+use crate::render::world::lanes::{self, Rng8, F8, LANES, M8, V8};
+use crate::render::world::light::{Emitter, LightSample, LightSource};
+use crate::render::world::World;
+
+/// What an item asks to draw at its next hit, if that is not specular.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Want {
+    /// Its stream's state (`Sampler::state`).
+    pub(crate) state: u64,
+    /// What it draws there before it scatters.
+    pub(crate) before: Before,
+}
+
+/// What an item draws at a hit before its direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Before {
+    Nothing,
+    /// A light for next-event estimation: its pick, and a sample of it
+    /// if one is picked.
+    Light,
+    /// A point on the camera's lens (`Sampler::next_2d`).
+    Lens,
+}
+
+/// A light drawn for next-event estimation: its index, the probability it
+/// was picked with, and its sample (None: it gives none at the point).
+pub(crate) type PickedLight = (usize, f32, Option<LightSample>);
+
+/// What an item drew at its hit, as its scalar code would have.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Given {
+    /// Its stream's state after the draws.
+    pub(crate) state: u64,
+    /// None where no light was picked (or none asked for).
+    pub(crate) light: Option<PickedLight>,
+    /// The lens sample, if asked for.
+    pub(crate) lens: Option<Vec2>,
+    /// None where the drawn direction goes nowhere (below the surface).
+    pub(crate) scattered: Option<BsdfSample>,
+}
+
+impl PathLanes {
+    /// The draws of the lanes that `wants` asks for and that `hits` found on
+    /// a surface that is not specular, the rays arriving along `direction`,
+    /// into `given` (None in every other lane); `pick` chooses a light from
+    /// a uniform number (`LightPicker::pick`).
+    #[inline(always)]
+    pub(crate) fn draw_at_hits(
+        &self,
+        world: &World,
+        hits: &LaneHits,
+        direction: V8,
+        wants: &[Option<Want>; LANES],
+        pick: &impl Fn(f32) -> Option<(usize, f32)>,
+        given: &mut [Option<Given>; LANES],
+    ) {
+        let wanted = hits.found.and(M8::from_fn(|i| wants[i].is_some()));
+        let surfaces = LaneSurfaces::new(&self.surfaces, &hits.shape, wanted);
+        let drawing = surfaces.lambert.or(surfaces.glossy.mask());
+        if !drawing.any() {
+            given.iter_mut().for_each(|g| *g = None);
+            return;
+        }
+        let mut rng = Rng8::from_states(lanes::each(|i| wants[i].map_or(0, |want| want.state)));
+        let (point, normal, error) = (hits.point, hits.normal, hits.error);
+        // The light first: its pick, then (if one was picked) its sample
+        let before = |what: Before| drawing.and(M8::from_fn(|i| wants[i].is_some_and(|want| want.before == what)));
+        let (sampling, on_lens) = (before(Before::Light), before(Before::Lens));
+        let lens = rng.next_2d(on_lens);
+        let u_pick = rng.next_f32(sampling).to_array();
+        let mut picked = [None; LANES];
+        for lane in sampling.lanes() {
+            picked[lane] = pick(u_pick[lane]);
+        }
+        let sampled = M8::from_fn(|i| picked[i].is_some());
+        let u = rng.next_2d(sampled);
+        let light = match sampled.any() {
+            true => {
+                let hit = |i: usize| SurfaceHit {
+                    t: hits.t.lane(i),
+                    point: point.lane(i),
+                    normal: normal.lane(i),
+                    error: error.lane(i),
+                };
+                let index = lanes::each(|i| picked[i].map_or(0, |(index, _)| index));
+                Some(LightLanes::sample(&self.lights, world, &index, sampled, point, normal, error, u, &hit))
+            }
+            false => None,
+        };
+        // Then the direction it scatters into
+        let wo = -direction;
+        let facing = normal.dot(wo).lt(F8::splat(0.0)).select_v(-normal, normal);
+        // Radiance or importance alike: only glass tells them apart
+        let Scattered { go, wi, weight, pdf, .. } = surfaces.scatter(&mut rng, wo, normal, facing, Transport::Radiance);
+        // Out of the registers first: closures do not inherit AVX2
+        let states = rng.states();
+        #[allow(clippy::manual_map)] // a closure here would not inherit AVX2
+        let light = match light {
+            Some(light) => Some(Columns::of(&light)),
+            None => None,
+        };
+        let (go, on_lens) = (go.bits(), on_lens.bits());
+        let lens = (lens.0.to_array(), lens.1.to_array());
+        let (wi, weight, pdf) = (Columns::v(wi), Columns::v(weight), pdf.to_array());
+        let drawing = drawing.bits();
+        for (lane, given) in given.iter_mut().enumerate() {
+            if drawing & 1 << lane == 0 {
+                *given = None;
+                continue;
+            }
+            *given = Some(Given {
+                state: states[lane],
+                light: picked[lane].map(|(index, probability)| {
+                    let sample = light.as_ref().and_then(|light| light.sample(lane, &world.lights[index]));
+                    (index, probability, sample)
+                }),
+                lens: (on_lens & 1 << lane != 0).then(|| Vec2::new(lens.0[lane], lens.1[lane])),
+                scattered: (go & 1 << lane != 0).then(|| BsdfSample {
+                    wi: wi(lane),
+                    weight: weight(lane),
+                    pdf: pdf[lane],
+                    delta: false,
+                }),
+            });
+        }
+    }
+}
+
+/// `LightLanes` out of the registers, lane by lane.
+struct Columns {
+    valid: u32,
+    wi: [[f32; LANES]; 3],
+    value: [[f32; LANES]; 3],
+    pdf: [f32; LANES],
+    origin: [[f32; LANES]; 3],
+    t_max: [f32; LANES],
+    point: [[f32; LANES]; 3],
+    normal: [[f32; LANES]; 3],
+}
+
+impl Columns {
+    #[inline(always)]
+    fn of(light: &LightLanes) -> Self {
+        let v = |v: V8| [v.x.to_array(), v.y.to_array(), v.z.to_array()];
+        Columns {
+            valid: light.valid.bits(),
+            wi: v(light.wi),
+            value: v(light.value),
+            pdf: light.pdf.to_array(),
+            origin: v(light.origin),
+            t_max: light.t_max.to_array(),
+            point: v(light.point),
+            normal: v(light.light_normal),
+        }
+    }
+
+    /// Lane by lane, a vector's columns.
+    #[inline(always)]
+    fn v(v: V8) -> impl Fn(usize) -> Vec3 {
+        let [x, y, z] = [v.x.to_array(), v.y.to_array(), v.z.to_array()];
+        move |i| Vec3::new(x[i], y[i], z[i])
+    }
+
+    /// Lane `i` as `LightSource::sample` gives it for `light`.
+    fn sample(&self, i: usize, light: &LightSource) -> Option<LightSample> {
+        if self.valid & 1 << i == 0 {
+            return None;
+        }
+        let (on_triangle, on_sphere) = match *light {
+            LightSource::Area { emitter: Emitter::Triangle { triangle, .. }, .. } => (Some(triangle), None),
+            LightSource::Area { emitter: Emitter::Sphere { sphere, .. }, .. } => (None, Some(sphere)),
+            _ => (None, None),
+        };
+        let at = |c: &[[f32; LANES]; 3]| Vec3::new(c[0][i], c[1][i], c[2][i]);
+        let wi = at(&self.wi);
+        Some(LightSample {
+            wi,
+            value: at(&self.value),
+            pdf: self.pdf[i],
+            shadow: Ray::new(at(&self.origin), wi),
+            shadow_t_max: self.t_max[i],
+            on_triangle,
+            on_sphere,
+            point: at(&self.point),
+            normal: at(&self.normal),
+        })
+    }
+}
