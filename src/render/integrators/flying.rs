@@ -11,6 +11,7 @@ use std::ops::Range;
 
 use super::path_lanes::{Given, PathLanes, Want};
 use crate::geometry::Ray;
+use crate::render::world::camera::CameraModel;
 use crate::render::world::lanes::{self, LANES};
 use crate::render::world::{Hit, World};
 
@@ -43,6 +44,8 @@ pub(crate) trait DrawAtHits<T> {
     fn want(&self, item: &T) -> Option<Want>;
     /// The light chosen by a uniform number (`LightPicker::pick`).
     fn pick(&self, u: f32) -> Option<(usize, f32)>;
+    /// The camera that items join.
+    fn camera(&self) -> Option<&CameraModel>;
 }
 
 /// Items that draw nothing in the lanes.
@@ -54,6 +57,10 @@ impl<T> DrawAtHits<T> for NoDraws {
     }
 
     fn pick(&self, _: f32) -> Option<(usize, f32)> {
+        None
+    }
+
+    fn camera(&self) -> Option<&CameraModel> {
         None
     }
 }
@@ -142,7 +149,8 @@ fn fly_lanes<T>(
         let (lane_hits, direction) = path_lanes.lane_hits(&rays);
         let drawn = wants.iter().any(Option::is_some);
         if drawn {
-            path_lanes.draw_at_hits(world, &lane_hits, direction, &wants, &|u| draws.pick(u), &mut given);
+            let pick = |u| draws.pick(u);
+            path_lanes.draw_at_hits(world, &lane_hits, direction, &wants, &pick, draws.camera(), &mut given);
         }
         let hits = path_lanes.hits_of(world, &lane_hits);
         for ((slot, hit), given) in flying.iter_mut().zip(&hits).zip(&given) {

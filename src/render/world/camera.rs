@@ -2,10 +2,10 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::real::{Real, V3};
+use crate::geometry::real::{Mask, Real, V3};
 use crate::geometry::Ray;
 use crate::render::world::rng::{PassStreams, Sampler};
-use crate::render::world::sampling::concentric_disk;
+use crate::render::world::sampling::{concentric_disk, concentric_disk_of};
 use crate::scene::{Camera, ClipAlong};
 
 #[derive(Clone, Debug)]
@@ -163,36 +163,70 @@ impl CameraModel {
     /// the way to the lens, and the density of the camera's ray there. None
     /// if it lands off the film, behind the camera, or before the near clip.
     pub fn connect(&self, point: Vec3, lens: Vec2) -> Option<CameraConnection> {
+        let seen = self.connect_of::<f32>(point.into(), (lens.x, lens.y));
+        seen.valid.then(|| {
+            let film = Vec2::new(seen.film.0, seen.film.1);
+            CameraConnection::new(
+                film,
+                seen.lens.into(),
+                seen.start,
+                seen.distance,
+                seen.to_camera.into(),
+                seen.ray_pdf,
+            )
+        })
+    }
+
+    /// `connect` for one point or several, each with its lens sample:
+    /// the connections, valid in the lanes of `valid`. Written once for
+    /// both, so the lanes see what `connect` sees, bit for bit.
+    #[inline(always)]
+    pub(crate) fn connect_of<R: Real>(&self, point: V3<R>, lens: (R, R)) -> ConnectionOf<R> {
+        let zero = R::splat(0.0);
+        let position = V3::splat(self.position);
         let on_lens = if self.aperture_radius > 0.0 {
-            let l = concentric_disk(lens) * self.aperture_radius;
-            self.position + self.right * l.x + self.up * l.y
+            let (x, y) = concentric_disk_of(lens.0, lens.1);
+            let (x, y) = (x * self.aperture_radius, y * self.aperture_radius);
+            position + V3::splat(self.right) * x + V3::splat(self.up) * y
         } else {
-            self.position
+            position
         };
         let to_point = point - on_lens;
         let distance = to_point.length();
         let direction = to_point / distance;
-        let cos = direction.dot(self.forward);
-        if cos <= 0.0 || !distance.is_finite() {
-            return None;
-        }
+        let forward = V3::splat(self.forward);
+        let cos = direction.dot(forward);
+        // Lanes out: behind the camera, off the film, before the near clip
+        let mut out = cos.le(zero);
         // A lens images the point where its ray through the lens centre
         // crosses the focus plane
-        let imaged = if self.aperture_radius > 0.0 { on_lens + direction * (self.focus_distance / cos) } else { point };
-        let film = self.project(imaged)?;
-        if !(film.x >= 0.0 && film.x < self.width && film.y >= 0.0 && film.y < self.height) {
-            return None;
-        }
-        let start = self.clip_distance(direction);
-        (distance > start).then(|| CameraConnection {
-            film,
-            pixel: (film.x as u32, film.y as u32),
+        let imaged = if self.aperture_radius > 0.0 {
+            on_lens + direction * (R::splat(self.focus_distance) / cos)
+        } else {
+            point
+        };
+        // `project`
+        let v = imaged - position;
+        let depth = v.dot(forward);
+        out = out.or(depth.le(zero));
+        let sx = v.dot(V3::splat(self.right)) / depth / R::splat(self.half_width);
+        let sy = v.dot(V3::splat(self.up)) / depth / R::splat(self.half_height);
+        let film_x = (sx + 1.0) * 0.5 * self.width;
+        let film_y = (R::splat(1.0) - sy) * 0.5 * self.height;
+        let on_film = (film_x.ge(zero).and(film_x.lt(R::splat(self.width))))
+            .and(film_y.ge(zero).and(film_y.lt(R::splat(self.height))));
+        let start = if self.clip_along_ray { R::splat(self.near_clip) } else { R::splat(self.near_clip) / cos };
+        // `ray_pdf`, for the lanes that reach here with cos > 0
+        let ray_pdf = R::splat(1.0) / (R::splat(self.pixel_size.x * self.pixel_size.y) * cos * cos * cos);
+        ConnectionOf {
+            valid: on_film.and(distance.is_finite()).and_not(out).and(distance.gt(start)),
+            film: (film_x, film_y),
             lens: on_lens,
             start,
             distance,
             to_camera: -direction,
-            ray_pdf: self.ray_pdf(direction),
-        })
+            ray_pdf,
+        }
     }
 
     /// Where the central ray starts: the middle of the near-clip rectangle
@@ -224,6 +258,26 @@ pub struct CameraConnection {
     pub to_camera: Vec3,
     /// `CameraModel::ray_pdf` of the ray from the lens to the point.
     pub ray_pdf: f32,
+}
+
+/// `CameraConnection`s of one point or several (`connect_of`), valid in
+/// the lanes of `valid`.
+pub(crate) struct ConnectionOf<R: Real> {
+    pub(crate) valid: R::Mask,
+    pub(crate) film: (R, R),
+    pub(crate) lens: V3<R>,
+    pub(crate) start: R,
+    pub(crate) distance: R,
+    pub(crate) to_camera: V3<R>,
+    pub(crate) ray_pdf: R,
+}
+
+impl CameraConnection {
+    /// The connection landing at `film`, in the pixel that holds it.
+    #[inline(always)]
+    pub(crate) fn new(film: Vec2, lens: Vec3, start: f32, distance: f32, to_camera: Vec3, ray_pdf: f32) -> Self {
+        CameraConnection { film, pixel: (film.x as u32, film.y as u32), lens, start, distance, to_camera, ray_pdf }
+    }
 }
 
 /// A rectangle of the image: what one task of a pass renders.

@@ -23,11 +23,11 @@ use super::Context;
 use crate::geometry::Ray;
 use crate::render::integrators::flying::{self, DrawAtHits};
 use crate::render::integrators::next_event::PathScope;
-use crate::render::integrators::path_lanes::{Before, Given, PickedLight, Want};
+use crate::render::integrators::path_lanes::{Given, PickedLight, Want};
 use crate::render::integrators::shadow_batch::ShadowBatch;
 use crate::render::integrators::{reorder, Counters};
 use crate::render::world::bsdf::{Bsdf, Transport};
-use crate::render::world::camera::CameraTile;
+use crate::render::world::camera::{CameraModel, CameraTile};
 use crate::render::world::light::LightSource;
 use crate::render::world::occluders::Shadow;
 use crate::render::world::rng::Sampler;
@@ -159,12 +159,16 @@ impl DrawAtHits<CameraPath<'_>> for CameraDraws<'_> {
     fn want(&self, path: &CameraPath) -> Option<Want> {
         let ctx = self.ctx;
         let goes_on = !ctx.light_tracing && path.length < ctx.max_length;
-        let before = if ctx.strategies.connect { Before::Light } else { Before::Nothing };
-        goes_on.then(|| Want { state: path.sampler.state(), before })
+        let light = ctx.strategies.connect;
+        goes_on.then(|| Want { state: path.sampler.state(), light, join: false, scatter: true })
     }
 
     fn pick(&self, u: f32) -> Option<(usize, f32)> {
         self.ctx.picker.pick(u)
+    }
+
+    fn camera(&self) -> Option<&CameraModel> {
+        None
     }
 }
 

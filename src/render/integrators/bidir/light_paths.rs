@@ -20,10 +20,11 @@ use crate::geometry::{Ray, SurfaceHit};
 use crate::render::film::Splat;
 use crate::render::integrators::flying::{self, DrawAtHits};
 use crate::render::integrators::next_event::PathScope;
-use crate::render::integrators::path_lanes::{Before, Given, PathLanes, Want};
+use crate::render::integrators::path_lanes::{Given, PathLanes, Want};
 use crate::render::integrators::shadow_batch::ShadowBatch;
 use crate::render::integrators::{reorder, Counters};
 use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::camera::{CameraConnection, CameraModel};
 use crate::render::world::light::LightSource;
 use crate::render::world::occluders::Shadow;
 use crate::render::world::rng::Sampler;
@@ -204,8 +205,8 @@ struct Flight<'w> {
     length: u32,
 }
 
-/// Light subpaths draw their lens samples and directions in the lanes
-/// where they can: at every vertex that may scatter.
+/// Light subpaths find how the camera sees their vertices and draw their
+/// directions in the lanes where they can.
 struct LightDraws<'c, 'w> {
     ctx: &'c Context<'w>,
 }
@@ -213,13 +214,18 @@ struct LightDraws<'c, 'w> {
 impl DrawAtHits<Flight<'_>> for LightDraws<'_, '_> {
     fn want(&self, path: &Flight) -> Option<Want> {
         let ctx = self.ctx;
-        let joins = (ctx.strategies.connect || ctx.light_tracing) && ctx.camera.has_lens();
-        let before = if joins { Before::Lens } else { Before::Nothing };
-        (path.length + 2 <= ctx.max_length).then(|| Want { state: path.sampler.state(), before })
+        let join = ctx.strategies.connect || ctx.light_tracing;
+        // Where `bounce` scatters
+        let scatter = path.length + 2 <= ctx.max_length;
+        (join || scatter).then(|| Want { state: path.sampler.state(), light: false, join, scatter })
     }
 
     fn pick(&self, u: f32) -> Option<(usize, f32)> {
         self.ctx.picker.pick(u)
+    }
+
+    fn camera(&self) -> Option<&CameraModel> {
+        Some(self.ctx.camera)
     }
 }
 
@@ -280,12 +286,14 @@ impl<'w> Flights<'_, 'w> {
                 out.vertices.push(vertex);
             }
             if s.connect || ctx.light_tracing {
-                let lens = match drawn {
-                    Some(given) => given.lens.unwrap_or(Vec2::ZERO),
-                    None if ctx.camera.has_lens() => sampler.next_2d(),
-                    None => Vec2::ZERO,
+                let seen = match drawn {
+                    Some(given) => given.seen,
+                    None => {
+                        let lens = if ctx.camera.has_lens() { sampler.next_2d() } else { Vec2::ZERO };
+                        ctx.camera.connect(vertex.hit.point, lens)
+                    }
                 };
-                join_camera(ctx, &path.scope, &vertex, lens, place, out);
+                join_camera(ctx, &path.scope, &vertex, seen, place, out);
             }
         }
         // A longer path would have no strategy left to finish it
@@ -349,12 +357,20 @@ impl<'w> Flights<'_, 'w> {
     }
 }
 
-/// A light vertex joined to the camera (t = 1) through `lens` (a point on
-/// the lens, if it has one): a splat on the pixel it lands on, weighed against every other strategy for the same path
-/// (plain light tracing weighs it 1: it is the only one it has), once its
-/// shadow ray, traced with others (`ChunkPaths::trace_joins`), gets through.
-fn join_camera(ctx: &Context, scope: &PathScope, vertex: &LightVertex, lens: Vec2, place: u32, out: &mut ChunkPaths) {
-    let Some(seen) = ctx.camera.connect(vertex.hit.point, lens) else { return };
+/// A light vertex joined to the camera (t = 1), as the camera sees it
+/// (`seen`; None: it does not): a splat on the pixel it lands on, weighed
+/// against every other strategy for the same path (plain light tracing
+/// weighs it 1: it is the only one it has), once its shadow ray, traced
+/// with others (`ChunkPaths::trace_joins`), gets through.
+fn join_camera(
+    ctx: &Context,
+    scope: &PathScope,
+    vertex: &LightVertex,
+    seen: Option<CameraConnection>,
+    place: u32,
+    out: &mut ChunkPaths,
+) {
+    let Some(seen) = seen else { return };
     let facing = vertex.facing();
     let f = vertex.bsdf.eval(vertex.wo, seen.to_camera, facing);
     if f == Rgb::ZERO {

@@ -1,8 +1,10 @@
 //! What items flying eight at a time (`flying`) draw at their hits, in the
 //! lanes: at a surface that is not specular, a light sample for next-event
-//! estimation and a scattered direction (`LightSource::sample` and
-//! `Bsdf::sample`), from each item's own stream in the order the scalar
-//! code draws them, so the items go on as if they had drawn them alone.
+//! estimation, how the camera sees the hit (through a point drawn on its
+//! lens) and a scattered direction (`LightSource::sample`,
+//! `CameraModel::connect` and `Bsdf::sample`), from each item's own stream
+//! in the order the scalar code draws them, so the items go on as if they
+//! had drawn them alone.
 
 use glam::{Vec2, Vec3};
 
@@ -10,28 +12,25 @@ use super::lights::LightLanes;
 use super::{LaneHits, LaneSurfaces, PathLanes, Scattered};
 use crate::geometry::{Ray, SurfaceHit};
 use crate::render::world::bsdf::{BsdfSample, Transport};
+use crate::render::world::camera::{CameraConnection, CameraModel, ConnectionOf};
 use crate::render::world::lanes::{self, Rng8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSample, LightSource};
 use crate::render::world::World;
 
-/// What an item asks to draw at its next hit, if that is not specular.
+/// What an item asks to draw (and to have computed) at its next hit, if
+/// that is not specular, in this order.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Want {
     /// Its stream's state (`Sampler::state`).
     pub(crate) state: u64,
-    /// What it draws there before it scatters.
-    pub(crate) before: Before,
-}
-
-/// What an item draws at a hit before its direction.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Before {
-    Nothing,
-    /// A light for next-event estimation: its pick, and a sample of it
-    /// if one is picked.
-    Light,
-    /// A point on the camera's lens (`Sampler::next_2d`).
-    Lens,
+    /// A light for next-event estimation: its pick, and a sample of it if
+    /// one is picked.
+    pub(crate) light: bool,
+    /// How the camera sees the hit (`CameraModel::connect`), through a
+    /// point drawn on its lens if it has one.
+    pub(crate) join: bool,
+    /// The direction it scatters into.
+    pub(crate) scatter: bool,
 }
 
 /// A light drawn for next-event estimation: its index, the probability it
@@ -45,8 +44,8 @@ pub(crate) struct Given {
     pub(crate) state: u64,
     /// None where no light was picked (or none asked for).
     pub(crate) light: Option<PickedLight>,
-    /// The lens sample, if asked for.
-    pub(crate) lens: Option<Vec2>,
+    /// How the camera sees the hit, if asked for (None: it does not).
+    pub(crate) seen: Option<CameraConnection>,
     /// None where the drawn direction goes nowhere (below the surface).
     pub(crate) scattered: Option<BsdfSample>,
 }
@@ -55,7 +54,8 @@ impl PathLanes {
     /// The draws of the lanes that `wants` asks for and that `hits` found on
     /// a surface that is not specular, the rays arriving along `direction`,
     /// into `given` (None in every other lane); `pick` chooses a light from
-    /// a uniform number (`LightPicker::pick`).
+    /// a uniform number (`LightPicker::pick`), `camera` sees the joins.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(crate) fn draw_at_hits(
         &self,
@@ -64,6 +64,7 @@ impl PathLanes {
         direction: V8,
         wants: &[Option<Want>; LANES],
         pick: &impl Fn(f32) -> Option<(usize, f32)>,
+        camera: Option<&CameraModel>,
         given: &mut [Option<Given>; LANES],
     ) {
         let wanted = hits.found.and(M8::from_fn(|i| wants[i].is_some()));
@@ -73,12 +74,11 @@ impl PathLanes {
             given.iter_mut().for_each(|g| *g = None);
             return;
         }
+        let asking = |what: fn(&Want) -> bool| drawing.and(M8::from_fn(|i| wants[i].as_ref().is_some_and(what)));
         let mut rng = Rng8::from_states(lanes::each(|i| wants[i].map_or(0, |want| want.state)));
         let (point, normal, error) = (hits.point, hits.normal, hits.error);
-        // The light first: its pick, then (if one was picked) its sample
-        let before = |what: Before| drawing.and(M8::from_fn(|i| wants[i].is_some_and(|want| want.before == what)));
-        let (sampling, on_lens) = (before(Before::Light), before(Before::Lens));
-        let lens = rng.next_2d(on_lens);
+        // A light: its pick, then (if one was picked) its sample
+        let sampling = asking(|want| want.light);
         let u_pick = rng.next_f32(sampling).to_array();
         let mut picked = [None; LANES];
         for lane in sampling.lanes() {
@@ -99,10 +99,27 @@ impl PathLanes {
             }
             false => None,
         };
-        // Then the direction it scatters into
+        // The camera, through a point on its lens if it has one
+        let joining = match camera {
+            Some(_) => asking(|want| want.join),
+            None => M8::NONE,
+        };
+        let seen = match camera {
+            Some(camera) if joining.any() => {
+                let lens = if camera.has_lens() { rng.next_2d(joining) } else { (F8::splat(0.0), F8::splat(0.0)) };
+                Some(Seen::of(camera.connect_of(point, lens), joining))
+            }
+            _ => None,
+        };
+        // The direction it scatters into; radiance or importance alike,
+        // only glass tells them apart
+        let scattering = asking(|want| want.scatter);
+        let surfaces = match scattering.bits() == drawing.bits() {
+            true => surfaces,
+            false => LaneSurfaces::new(&self.surfaces, &hits.shape, scattering),
+        };
         let wo = -direction;
         let facing = normal.dot(wo).lt(F8::splat(0.0)).select_v(-normal, normal);
-        // Radiance or importance alike: only glass tells them apart
         let Scattered { go, wi, weight, pdf, .. } = surfaces.scatter(&mut rng, wo, normal, facing, Transport::Radiance);
         // Out of the registers first: closures do not inherit AVX2
         let states = rng.states();
@@ -111,8 +128,7 @@ impl PathLanes {
             Some(light) => Some(Columns::of(&light)),
             None => None,
         };
-        let (go, on_lens) = (go.bits(), on_lens.bits());
-        let lens = (lens.0.to_array(), lens.1.to_array());
+        let go = go.and(scattering).bits();
         let (wi, weight, pdf) = (Columns::v(wi), Columns::v(weight), pdf.to_array());
         let drawing = drawing.bits();
         for (lane, given) in given.iter_mut().enumerate() {
@@ -126,7 +142,7 @@ impl PathLanes {
                     let sample = light.as_ref().and_then(|light| light.sample(lane, &world.lights[index]));
                     (index, probability, sample)
                 }),
-                lens: (on_lens & 1 << lane != 0).then(|| Vec2::new(lens.0[lane], lens.1[lane])),
+                seen: seen.as_ref().and_then(|seen| seen.connection(lane)),
                 scattered: (go & 1 << lane != 0).then(|| BsdfSample {
                     wi: wi(lane),
                     weight: weight(lane),
@@ -135,6 +151,51 @@ impl PathLanes {
                 }),
             });
         }
+    }
+}
+
+/// `CameraModel::connect_of`'s connections out of the registers.
+struct Seen {
+    valid: u32,
+    film: ([f32; LANES], [f32; LANES]),
+    lens: [[f32; LANES]; 3],
+    start: [f32; LANES],
+    distance: [f32; LANES],
+    to_camera: [[f32; LANES]; 3],
+    ray_pdf: [f32; LANES],
+}
+
+impl Seen {
+    /// The connections of the lanes of `joining`.
+    #[inline(always)]
+    fn of(seen: ConnectionOf<F8>, joining: M8) -> Self {
+        let v = |v: V8| [v.x.to_array(), v.y.to_array(), v.z.to_array()];
+        Seen {
+            valid: seen.valid.and(joining).bits(),
+            film: (seen.film.0.to_array(), seen.film.1.to_array()),
+            lens: v(seen.lens),
+            start: seen.start.to_array(),
+            distance: seen.distance.to_array(),
+            to_camera: v(seen.to_camera),
+            ray_pdf: seen.ray_pdf.to_array(),
+        }
+    }
+
+    /// Lane `i`'s, as `CameraModel::connect` gives it.
+    fn connection(&self, i: usize) -> Option<CameraConnection> {
+        if self.valid & 1 << i == 0 {
+            return None;
+        }
+        let at = |c: &[[f32; LANES]; 3]| Vec3::new(c[0][i], c[1][i], c[2][i]);
+        let film = Vec2::new(self.film.0[i], self.film.1[i]);
+        Some(CameraConnection::new(
+            film,
+            at(&self.lens),
+            self.start[i],
+            self.distance[i],
+            at(&self.to_camera),
+            self.ray_pdf[i],
+        ))
     }
 }
 

@@ -21,7 +21,7 @@ mod lights;
 mod samples;
 mod scatter;
 
-pub(crate) use draws::{Before, Given, PickedLight, Want};
+pub(crate) use draws::{Given, PickedLight, Want};
 pub(crate) use lights::EmittedLanes;
 use lights::{LaneLights, LightLanes};
 use samples::{CameraSample, CameraSamples};
