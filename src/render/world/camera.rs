@@ -459,4 +459,49 @@ mod tests {
         assert!((pa - pb).length() < 1e-4, "{pa} vs {pb}");
         assert!((a.origin - b.origin).length() > 0.1);
     }
+
+    /// `connect_of` in eight lanes is `connect` lane by lane, bit for bit,
+    /// through a pinhole and a lens, near clips along the ray and the axis,
+    /// for points in front of the camera, beside it, behind it and inside
+    /// the near clip.
+    #[test]
+    fn connect_in_the_lanes_is_connect_lane_by_lane() {
+        use crate::render::world::lanes::{F8, LANES, V8};
+        use crate::render::world::rng::Sampler;
+        let mut sampler = Sampler::new(7, 0, 3);
+        let (mut seen, mut unseen) = (0, 0);
+        for (aperture_radius, near_clip_along) in
+            [(0.0, ClipAlong::ViewAxis), (0.3, ClipAlong::ViewAxis), (0.3, ClipAlong::Ray)]
+        {
+            let model = CameraModel::new(&Camera { aperture_radius, near_clip_along, ..camera() }, 64, 48);
+            for _ in 0..200 {
+                // Points in a box about the camera at z = 5, most in front of it
+                let points: [Vec3; LANES] = std::array::from_fn(|_| {
+                    let (a, b) = (sampler.next_2d(), sampler.next_2d());
+                    Vec3::new(a.x * 12.0 - 6.0, a.y * 12.0 - 6.0, b.x * 10.0 - 4.0)
+                });
+                let lens: [Vec2; LANES] = std::array::from_fn(|_| sampler.next_2d());
+                let lanes = model
+                    .connect_of(V8::from_fn(|i| points[i]), (F8::from_fn(|i| lens[i].x), F8::from_fn(|i| lens[i].y)));
+                for i in 0..LANES {
+                    let one = model.connect(points[i], lens[i]);
+                    assert_eq!(lanes.valid.test(i), one.is_some(), "{:?} through {:?}", points[i], lens[i]);
+                    let Some(one) = one else {
+                        unseen += 1;
+                        continue;
+                    };
+                    seen += 1;
+                    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                    assert_eq!(lanes.film.0.lane(i).to_bits(), one.film.x.to_bits());
+                    assert_eq!(lanes.film.1.lane(i).to_bits(), one.film.y.to_bits());
+                    assert_eq!(bits(lanes.lens.lane(i)), bits(one.lens));
+                    assert_eq!(lanes.start.lane(i).to_bits(), one.start.to_bits());
+                    assert_eq!(lanes.distance.lane(i).to_bits(), one.distance.to_bits());
+                    assert_eq!(bits(lanes.to_camera.lane(i)), bits(one.to_camera));
+                    assert_eq!(lanes.ray_pdf.lane(i).to_bits(), one.ray_pdf.to_bits());
+                }
+            }
+        }
+        assert!(seen > 1000 && unseen > 1000, "{seen} seen, {unseen} not");
+    }
 }
