@@ -129,7 +129,7 @@ impl PathLanes {
             None => None,
         };
         let go = go.and(scattering).bits();
-        let (wi, weight, pdf) = (Columns::v(wi), Columns::v(weight), pdf.to_array());
+        let (wi, weight, pdf) = (columns_of(wi), columns_of(weight), pdf.to_array());
         let drawing = drawing.bits();
         for (lane, given) in given.iter_mut().enumerate() {
             if drawing & 1 << lane == 0 {
@@ -144,8 +144,8 @@ impl PathLanes {
                 }),
                 seen: seen.as_ref().and_then(|seen| seen.connection(lane)),
                 scattered: (go & 1 << lane != 0).then(|| BsdfSample {
-                    wi: wi(lane),
-                    weight: weight(lane),
+                    wi: lane_of(&wi, lane),
+                    weight: lane_of(&weight, lane),
                     pdf: pdf[lane],
                     delta: false,
                 }),
@@ -169,14 +169,13 @@ impl Seen {
     /// The connections of the lanes of `joining`.
     #[inline(always)]
     fn of(seen: ConnectionOf<F8>, joining: M8) -> Self {
-        let v = |v: V8| [v.x.to_array(), v.y.to_array(), v.z.to_array()];
         Seen {
             valid: seen.valid.and(joining).bits(),
             film: (seen.film.0.to_array(), seen.film.1.to_array()),
-            lens: v(seen.lens),
+            lens: columns_of(seen.lens),
             start: seen.start.to_array(),
             distance: seen.distance.to_array(),
-            to_camera: v(seen.to_camera),
+            to_camera: columns_of(seen.to_camera),
             ray_pdf: seen.ray_pdf.to_array(),
         }
     }
@@ -186,16 +185,9 @@ impl Seen {
         if self.valid & 1 << i == 0 {
             return None;
         }
-        let at = |c: &[[f32; LANES]; 3]| Vec3::new(c[0][i], c[1][i], c[2][i]);
         let film = Vec2::new(self.film.0[i], self.film.1[i]);
-        Some(CameraConnection::new(
-            film,
-            at(&self.lens),
-            self.start[i],
-            self.distance[i],
-            at(&self.to_camera),
-            self.ray_pdf[i],
-        ))
+        let (lens, to_camera) = (lane_of(&self.lens, i), lane_of(&self.to_camera, i));
+        Some(CameraConnection::new(film, lens, self.start[i], self.distance[i], to_camera, self.ray_pdf[i]))
     }
 }
 
@@ -214,24 +206,16 @@ struct Columns {
 impl Columns {
     #[inline(always)]
     fn of(light: &LightLanes) -> Self {
-        let v = |v: V8| [v.x.to_array(), v.y.to_array(), v.z.to_array()];
         Columns {
             valid: light.valid.bits(),
-            wi: v(light.wi),
-            value: v(light.value),
+            wi: columns_of(light.wi),
+            value: columns_of(light.value),
             pdf: light.pdf.to_array(),
-            origin: v(light.origin),
+            origin: columns_of(light.origin),
             t_max: light.t_max.to_array(),
-            point: v(light.point),
-            normal: v(light.light_normal),
+            point: columns_of(light.point),
+            normal: columns_of(light.light_normal),
         }
-    }
-
-    /// Lane by lane, a vector's columns.
-    #[inline(always)]
-    fn v(v: V8) -> impl Fn(usize) -> Vec3 {
-        let [x, y, z] = [v.x.to_array(), v.y.to_array(), v.z.to_array()];
-        move |i| Vec3::new(x[i], y[i], z[i])
     }
 
     /// Lane `i` as `LightSource::sample` gives it for `light`.
@@ -244,18 +228,28 @@ impl Columns {
             LightSource::Area { emitter: Emitter::Sphere { sphere, .. }, .. } => (None, Some(sphere)),
             _ => (None, None),
         };
-        let at = |c: &[[f32; LANES]; 3]| Vec3::new(c[0][i], c[1][i], c[2][i]);
-        let wi = at(&self.wi);
+        let wi = lane_of(&self.wi, i);
         Some(LightSample {
             wi,
-            value: at(&self.value),
+            value: lane_of(&self.value, i),
             pdf: self.pdf[i],
-            shadow: Ray::new(at(&self.origin), wi),
+            shadow: Ray::new(lane_of(&self.origin, i), wi),
             shadow_t_max: self.t_max[i],
             on_triangle,
             on_sphere,
-            point: at(&self.point),
-            normal: at(&self.normal),
+            point: lane_of(&self.point, i),
+            normal: lane_of(&self.normal, i),
         })
     }
+}
+
+/// A vector's eight lanes out of the registers, as columns.
+#[inline(always)]
+fn columns_of(v: V8) -> [[f32; LANES]; 3] {
+    [v.x.to_array(), v.y.to_array(), v.z.to_array()]
+}
+
+/// Lane `i` of a vector's columns.
+fn lane_of(columns: &[[f32; LANES]; 3], i: usize) -> Vec3 {
+    Vec3::new(columns[0][i], columns[1][i], columns[2][i])
 }
