@@ -71,7 +71,7 @@ impl CameraModel {
             let on_lens = self.position + self.right * l.x + self.up * l.y;
             let in_focus = self.position + through * self.focus_distance;
             let direction = (in_focus - on_lens).normalize();
-            let start = if self.clip_along_ray { self.near_clip } else { self.near_clip / direction.dot(self.forward) };
+            let start = self.clip_distance(direction);
             Ray::new(on_lens + direction * start, direction)
         } else {
             let (origin, direction) = self.pinhole_rays_of(film.x, film.y);
@@ -124,14 +124,21 @@ impl CameraModel {
 
     /// Film position (pixels) where a world point appears, if in front.
     pub fn project(&self, point: Vec3) -> Option<Vec2> {
-        let v = point - self.position;
-        let depth = v.dot(self.forward);
-        if depth <= 0.0 {
-            return None;
-        }
-        let sx = v.dot(self.right) / depth / self.half_width;
-        let sy = v.dot(self.up) / depth / self.half_height;
-        Some(Vec2::new((sx + 1.0) * 0.5 * self.width, (1.0 - sy) * 0.5 * self.height))
+        let (x, y, behind) = self.project_of::<f32>(point.into());
+        (!behind).then(|| Vec2::new(x, y))
+    }
+
+    /// `project` for one point or several: the film positions, and the
+    /// points behind the camera (whose positions mean nothing).
+    #[inline(always)]
+    fn project_of<R: Real>(&self, point: V3<R>) -> (R, R, R::Mask) {
+        let v = point - V3::splat(self.position);
+        let depth = v.dot(V3::splat(self.forward));
+        let sx = v.dot(V3::splat(self.right)) / depth / R::splat(self.half_width);
+        let sy = v.dot(V3::splat(self.up)) / depth / R::splat(self.half_height);
+        let x = (sx + 1.0) * 0.5 * self.width;
+        let y = (R::splat(1.0) - sy) * 0.5 * self.height;
+        (x, y, depth.le(R::splat(0.0)))
     }
 
     /// The density of the camera's rays along `direction` from the lens,
@@ -140,21 +147,31 @@ impl CameraModel {
     /// 1/(A cos³θ) (0 behind the camera).
     #[inline]
     pub fn ray_pdf(&self, direction: Vec3) -> f32 {
-        let cos = direction.dot(self.forward);
-        if cos <= 0.0 {
-            return 0.0;
-        }
-        1.0 / (self.pixel_size.x * self.pixel_size.y * cos * cos * cos)
+        self.ray_pdf_of::<f32>(direction.into())
+    }
+
+    /// `ray_pdf` for one direction or several.
+    #[inline(always)]
+    fn ray_pdf_of<R: Real>(&self, direction: V3<R>) -> R {
+        let cos = direction.dot(V3::splat(self.forward));
+        let pdf = R::splat(1.0) / (R::splat(self.pixel_size.x * self.pixel_size.y) * cos * cos * cos);
+        R::select(cos.le(R::splat(0.0)), R::splat(0.0), pdf)
     }
 
     /// How far from the lens a camera ray along `direction` starts (the
     /// near clip, along the ray or the view axis).
     #[inline]
     pub fn clip_distance(&self, direction: Vec3) -> f32 {
+        self.clip_distance_of::<f32>(direction.into())
+    }
+
+    /// `clip_distance` for one direction or several.
+    #[inline(always)]
+    fn clip_distance_of<R: Real>(&self, direction: V3<R>) -> R {
         if self.clip_along_ray {
-            self.near_clip
+            R::splat(self.near_clip)
         } else {
-            self.near_clip / direction.dot(self.forward)
+            R::splat(self.near_clip) / direction.dot(V3::splat(self.forward))
         }
     }
 
@@ -196,8 +213,6 @@ impl CameraModel {
         let direction = to_point / distance;
         let forward = V3::splat(self.forward);
         let cos = direction.dot(forward);
-        // Lanes out: behind the camera, off the film, before the near clip
-        let mut out = cos.le(zero);
         // A lens images the point where its ray through the lens centre
         // crosses the focus plane
         let imaged = if self.aperture_radius > 0.0 {
@@ -205,27 +220,20 @@ impl CameraModel {
         } else {
             point
         };
-        // `project`
-        let v = imaged - position;
-        let depth = v.dot(forward);
-        out = out.or(depth.le(zero));
-        let sx = v.dot(V3::splat(self.right)) / depth / R::splat(self.half_width);
-        let sy = v.dot(V3::splat(self.up)) / depth / R::splat(self.half_height);
-        let film_x = (sx + 1.0) * 0.5 * self.width;
-        let film_y = (R::splat(1.0) - sy) * 0.5 * self.height;
+        let (film_x, film_y, behind) = self.project_of(imaged);
         let on_film = (film_x.ge(zero).and(film_x.lt(R::splat(self.width))))
             .and(film_y.ge(zero).and(film_y.lt(R::splat(self.height))));
-        let start = if self.clip_along_ray { R::splat(self.near_clip) } else { R::splat(self.near_clip) / cos };
-        // `ray_pdf`, for the lanes that reach here with cos > 0
-        let ray_pdf = R::splat(1.0) / (R::splat(self.pixel_size.x * self.pixel_size.y) * cos * cos * cos);
+        let start = self.clip_distance_of(direction);
+        // Seen: ahead of the lens and the camera, on the film, past the near clip
+        let ahead = distance.is_finite().and_not(cos.le(zero)).and_not(behind);
         ConnectionOf {
-            valid: on_film.and(distance.is_finite()).and_not(out).and(distance.gt(start)),
+            valid: ahead.and(on_film).and(distance.gt(start)),
             film: (film_x, film_y),
             lens: on_lens,
             start,
             distance,
             to_camera: -direction,
-            ray_pdf,
+            ray_pdf: self.ray_pdf_of(direction),
         }
     }
 
