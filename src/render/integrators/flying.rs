@@ -4,8 +4,9 @@
 //! hit by itself, in scalar code. A lane whose item ends takes the next
 //! one, so the lanes stay busy however far items go; items end out of
 //! turn, so what they make is tagged with their place for `reorder`.
-//! Items that sample a light and scatter at their hits may draw those in
-//! the lanes too (`DrawAtHits`).
+//! What items draw at their hits (a light sample, a lens sample, the
+//! direction they scatter into) and how the camera sees a hit may be
+//! worked out in the lanes too (`DrawAtHits`).
 
 use std::ops::Range;
 
@@ -42,10 +43,15 @@ pub(crate) trait DrawAtHits<T> {
     /// What `item` asks to draw at its next hit (None: nothing), asked
     /// before its ray is traced.
     fn want(&self, item: &T) -> Option<Want>;
-    /// The light chosen by a uniform number (`LightPicker::pick`).
-    fn pick(&self, u: f32) -> Option<(usize, f32)>;
-    /// The camera that items join.
-    fn camera(&self) -> Option<&CameraModel>;
+    /// The light chosen by a uniform number (`LightPicker::pick`), for
+    /// items that sample lights.
+    fn pick(&self, _u: f32) -> Option<(usize, f32)> {
+        None
+    }
+    /// The camera, for items that join it.
+    fn camera(&self) -> Option<&CameraModel> {
+        None
+    }
 }
 
 /// Items that draw nothing in the lanes.
@@ -53,14 +59,6 @@ pub(crate) struct NoDraws;
 
 impl<T> DrawAtHits<T> for NoDraws {
     fn want(&self, _: &T) -> Option<Want> {
-        None
-    }
-
-    fn pick(&self, _: f32) -> Option<(usize, f32)> {
-        None
-    }
-
-    fn camera(&self) -> Option<&CameraModel> {
         None
     }
 }

@@ -27,7 +27,7 @@ use crate::render::integrators::path_lanes::{Given, PickedLight, Want};
 use crate::render::integrators::shadow_batch::ShadowBatch;
 use crate::render::integrators::{reorder, Counters};
 use crate::render::world::bsdf::{Bsdf, Transport};
-use crate::render::world::camera::{CameraModel, CameraTile};
+use crate::render::world::camera::CameraTile;
 use crate::render::world::light::LightSource;
 use crate::render::world::occluders::Shadow;
 use crate::render::world::rng::Sampler;
@@ -165,10 +165,6 @@ impl DrawAtHits<CameraPath<'_>> for CameraDraws<'_> {
 
     fn pick(&self, u: f32) -> Option<(usize, f32)> {
         self.ctx.picker.pick(u)
-    }
-
-    fn camera(&self) -> Option<&CameraModel> {
-        None
     }
 }
 
@@ -320,10 +316,7 @@ impl CameraPath<'_> {
             }
         }
         let scattered = match drawn {
-            Some(given) => {
-                *sampler = Sampler::from_state(given.state);
-                given.scattered
-            }
+            Some(given) => given.resume(sampler),
             None => bsdf.sample(wo, n, sampler, Transport::Radiance),
         };
         let Some(scattered) = scattered else { return false };

@@ -220,10 +220,6 @@ impl DrawAtHits<Flight<'_>> for LightDraws<'_, '_> {
         (join || scatter).then(|| Want { state: path.sampler.state(), light: false, join, scatter })
     }
 
-    fn pick(&self, u: f32) -> Option<(usize, f32)> {
-        self.ctx.picker.pick(u)
-    }
-
     fn camera(&self) -> Option<&CameraModel> {
         Some(self.ctx.camera)
     }
@@ -301,10 +297,7 @@ impl<'w> Flights<'_, 'w> {
             return false;
         }
         let scattered = match drawn {
-            Some(given) => {
-                *sampler = Sampler::from_state(given.state);
-                given.scattered
-            }
+            Some(given) => given.resume(sampler),
             None => bsdf.sample(wo, n, sampler, Transport::Importance),
         };
         let Some(scattered) = scattered else { return false };
@@ -416,9 +409,9 @@ mod tests {
     use crate::scene::{presets, Camera};
 
     /// Every preset, through a pinhole and a lens, and each way the light
-    /// subpaths are used (light
-    /// tracing, connecting, merging, both; the strategy view open or not;
-    /// paths of two segments at most and of eight):
+    /// subpaths are used (light tracing, connecting, merging, both; the
+    /// strategy view open or not; paths of two segments at most and of
+    /// eight):
     /// eight at a time, their shadow rays eight at a time, the paths make
     /// what they make one at a time — the same vertices, ends, splats,
     /// contributions and counts, bit for bit.

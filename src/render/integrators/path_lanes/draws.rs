@@ -15,6 +15,7 @@ use crate::render::world::bsdf::{BsdfSample, Transport};
 use crate::render::world::camera::{CameraConnection, CameraModel, ConnectionOf};
 use crate::render::world::lanes::{self, Rng8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSample, LightSource};
+use crate::render::world::rng::Sampler;
 use crate::render::world::World;
 
 /// What an item asks to draw (and to have computed) at its next hit, if
@@ -48,6 +49,15 @@ pub(crate) struct Given {
     pub(crate) seen: Option<CameraConnection>,
     /// None where the drawn direction goes nowhere (below the surface).
     pub(crate) scattered: Option<BsdfSample>,
+}
+
+impl Given {
+    /// Where its item goes on from: its stream after the draws, and the
+    /// direction drawn (None: it goes nowhere).
+    pub(crate) fn resume(&self, sampler: &mut Sampler) -> Option<BsdfSample> {
+        *sampler = Sampler::from_state(self.state);
+        self.scattered
+    }
 }
 
 impl PathLanes {
