@@ -24,7 +24,7 @@ const BLOCK: usize = 1 << 14;
 /// Up to this many buckets a query lists on the stack: 4×4×4, so neither
 /// SPPM's queries (3×3×3 cells, four along an axis where the padded box
 /// reaches past a third) nor VCM's (1 to 8) allocate.
-const FEW: usize = 64;
+pub(super) const FEW: usize = 64;
 
 pub struct PointGrid {
     origin: Vec3,
@@ -44,10 +44,10 @@ pub struct PointGrid {
 }
 
 /// The buckets a query touches, each once, in increasing order.
-// `Few` is large on purpose: a query's list stays on the stack
-#[allow(clippy::large_enum_variant)]
-pub(super) enum Touched {
-    Few([u32; FEW], usize),
+pub(super) enum Touched<'a> {
+    /// Listed in room on the caller's stack: returned by value, the list
+    /// itself was copied once per query (1% of a VCM render's instructions).
+    Few(&'a [u32]),
     Many(Vec<u32>),
     /// More cells than buckets: every point is a candidate.
     All,
@@ -102,7 +102,8 @@ impl PointGrid {
     /// `for_each_within`'s points, each named by its slot in the grid's
     /// order (where `in_grid_order_into` put its values), not by its index.
     pub fn for_each_slot_within(&self, point: Vec3, radius: f32, mut f: impl FnMut(usize)) {
-        let Some(touched) = self.touched(point, radius) else { return };
+        let mut few = [0; FEW];
+        let Some(touched) = self.touched(point, radius, &mut few) else { return };
         let bound = radius * radius;
         #[cfg(target_arch = "x86_64")]
         if self.lanes {
@@ -141,8 +142,8 @@ impl PointGrid {
         // Every bucket's first points asked for at once, not one bucket's
         // after another's (a merge's few buckets each miss the cache: BPM
         // and VCM on gap-room at 256×192 took 0.976 and 0.967 of the time)
-        if let Touched::Few(ids, len) = touched {
-            for &b in &ids[..*len] {
+        if let Touched::Few(ids) = touched {
+            for &b in *ids {
                 let start = self.starts[b as usize] as usize;
                 prefetch(&self.position[0][start]);
                 prefetch(&self.position[1][start]);
@@ -203,7 +204,7 @@ impl PointGrid {
 
     /// The buckets within `radius` of `point`; None where no point can be.
     #[inline(always)]
-    pub(super) fn touched(&self, point: Vec3, radius: f32) -> Option<Touched> {
+    pub(super) fn touched<'a>(&self, point: Vec3, radius: f32, few: &'a mut [u32; FEW]) -> Option<Touched<'a>> {
         if self.is_empty() || radius.is_nan() || radius < 0.0 {
             return None;
         }
@@ -227,17 +228,13 @@ impl PointGrid {
             }
         };
         Some(if cells as usize <= FEW {
-            // Filled where it lies: built aside and moved, its 260 bytes were
-            // copied twice per query (3% of a VCM render under perf)
-            let mut touched = Touched::Few([0; FEW], 0);
-            if let Touched::Few(ids, len) = &mut touched {
-                list(&mut |b| {
-                    ids[*len] = b;
-                    *len += 1;
-                });
-                *len = sort_dedup(&mut ids[..*len]);
-            }
-            touched
+            let mut len = 0;
+            list(&mut |b| {
+                few[len] = b;
+                len += 1;
+            });
+            let len = sort_dedup(&mut few[..len]);
+            Touched::Few(&few[..len])
         } else {
             let mut ids = Vec::with_capacity(cells as usize);
             list(&mut |b| ids.push(b));
@@ -250,7 +247,7 @@ impl PointGrid {
     /// The point ranges of the touched buckets, empty ones left out.
     pub(super) fn ranges<'a>(&'a self, touched: &'a Touched) -> impl Iterator<Item = (usize, usize)> + 'a {
         let ids: &[u32] = match touched {
-            Touched::Few(ids, len) => &ids[..*len],
+            Touched::Few(ids) => ids,
             Touched::Many(ids) => ids,
             Touched::All => &[],
         };
@@ -374,8 +371,9 @@ pub(super) mod tests {
             let inside = |s: &mut Sampler| s.next_f32().mul_add(0.4, 0.3) + (s.next_f32() * 9.0).floor();
             let (x, z) = (inside(&mut s), inside(&mut s));
             let point = Vec3::new(grid.origin.x + x * cell, 0.0, grid.origin.z + z * cell);
-            let Some(Touched::Few(_, len)) = grid.touched(point, cell * 0.25) else { panic!("no bucket list") };
-            assert_eq!(len, 1, "{point}");
+            let mut few = [0; FEW];
+            let Some(Touched::Few(ids)) = grid.touched(point, cell * 0.25, &mut few) else { panic!("no bucket list") };
+            assert_eq!(ids.len(), 1, "{point}");
         }
     }
 

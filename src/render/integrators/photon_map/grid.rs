@@ -11,7 +11,7 @@
 
 use glam::Vec3;
 
-use super::cells::{eight, fill_columns, PointGrid, Touched};
+use super::cells::{eight, fill_columns, PointGrid, Touched, FEW};
 use super::record::Photon;
 use crate::render::world::lanes::{F8, LANES};
 
@@ -64,7 +64,8 @@ impl PhotonGrid {
     /// count, and each one's index handed to `each`, in an order fixed by
     /// the photons and the query alone.
     pub fn gather_front(&self, point: Vec3, radius: f32, facing: Vec3, mut each: impl FnMut(usize)) -> FrontSum {
-        let Some(touched) = self.points.touched(point, radius) else { return FrontSum::default() };
+        let mut few = [0; FEW];
+        let Some(touched) = self.points.touched(point, radius, &mut few) else { return FrontSum::default() };
         let query = Query { point, bound: radius * radius, facing };
         #[cfg(target_arch = "x86_64")]
         if self.points.lanes {
