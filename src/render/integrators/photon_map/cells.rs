@@ -21,9 +21,10 @@ use crate::render::world::lanes::{self, F8, LANES};
 /// Points per block of the columns filled in parallel.
 const BLOCK: usize = 1 << 14;
 
-/// Up to this many buckets a query lists on the stack: 4×4×4, so neither
-/// SPPM's queries (3×3×3 cells, four along an axis where the padded box
-/// reaches past a third) nor VCM's (1 to 8) allocate.
+/// Up to this many runs of buckets a query lists on the stack, two a row
+/// along x (one where the buckets wrap past the last): 4×4 rows, so
+/// neither SPPM's queries (3×3 rows, four along an axis where the padded
+/// box reaches past a third) nor VCM's (1 to 4) allocate.
 pub(super) const FEW: usize = 64;
 
 pub struct PointGrid {
@@ -43,12 +44,17 @@ pub struct PointGrid {
     pub(super) lanes: bool,
 }
 
-/// The buckets a query touches, each once, in increasing order.
+/// Buckets `first..=last`: a row of cells along x, whose buckets follow
+/// one another (`bucket`), so their points lie in one stretch.
+pub(super) type Run = (u32, u32);
+
+/// The buckets a query touches, each once, as runs in increasing order,
+/// none touching the next.
 pub(super) enum Touched<'a> {
     /// Listed in room on the caller's stack: returned by value, the list
     /// itself was copied once per query (1% of a VCM render's instructions).
-    Few(&'a [u32]),
-    Many(Vec<u32>),
+    Few(&'a [Run]),
+    Many(Vec<Run>),
     /// More cells than buckets: every point is a candidate.
     All,
 }
@@ -102,7 +108,7 @@ impl PointGrid {
     /// `for_each_within`'s points, each named by its slot in the grid's
     /// order (where `in_grid_order_into` put its values), not by its index.
     pub fn for_each_slot_within(&self, point: Vec3, radius: f32, mut f: impl FnMut(usize)) {
-        let mut few = [0; FEW];
+        let mut few = [(0, 0); FEW];
         let Some(touched) = self.touched(point, radius, &mut few) else { return };
         let bound = radius * radius;
         #[cfg(target_arch = "x86_64")]
@@ -142,9 +148,9 @@ impl PointGrid {
         // Every bucket's first points asked for at once, not one bucket's
         // after another's (a merge's few buckets each miss the cache: BPM
         // and VCM on gap-room at 256×192 took 0.976 and 0.967 of the time)
-        if let Touched::Few(ids) = touched {
-            for &b in *ids {
-                let start = self.starts[b as usize] as usize;
+        if let Touched::Few(runs) = touched {
+            for &(first, _) in *runs {
+                let start = self.starts[first as usize] as usize;
                 prefetch(&self.position[0][start]);
                 prefetch(&self.position[1][start]);
                 prefetch(&self.position[2][start]);
@@ -202,9 +208,10 @@ impl PointGrid {
             & self.mask
     }
 
-    /// The buckets within `radius` of `point`; None where no point can be.
+    /// The lowest and highest cells within `radius` of `point`; None
+    /// where no point can be.
     #[inline(always)]
-    pub(super) fn touched<'a>(&self, point: Vec3, radius: f32, few: &'a mut [u32; FEW]) -> Option<Touched<'a>> {
+    fn cell_box(&self, point: Vec3, radius: f32) -> Option<([i32; 3], [i32; 3])> {
         if self.is_empty() || radius.is_nan() || radius < 0.0 {
             return None;
         }
@@ -212,47 +219,67 @@ impl PointGrid {
         // (squares rounding alike), and p ± reach rounds: the box is
         // widened for both
         let reach = radius * 1.001 + point.abs().max_element() * 1e-6;
-        let (lo, hi) = (self.cell_of(point - reach), self.cell_of(point + reach));
+        Some((self.cell_of(point - reach), self.cell_of(point + reach)))
+    }
+
+    /// The buckets within `radius` of `point`; None where no point can be.
+    /// Listed by rows along x, not cell by cell: a query's 27 cells (SPPM)
+    /// were 27 buckets to sort, and 27 stretches of points each ending in
+    /// a part-filled group of eight; its 9 rows are 9 runs and 9 stretches.
+    #[inline(always)]
+    pub(super) fn touched<'a>(&self, point: Vec3, radius: f32, few: &'a mut [Run; FEW]) -> Option<Touched<'a>> {
+        let (lo, hi) = self.cell_box(point, radius)?;
         let span = |axis: usize| (hi[axis] as i64 - lo[axis] as i64 + 1) as u64;
         let cells = span(0).saturating_mul(span(1)).saturating_mul(span(2));
         if cells > self.mask as u64 + 1 {
             return Some(Touched::All);
         }
-        let list = |push: &mut dyn FnMut(u32)| {
-            for x in lo[0] as i64..=hi[0] as i64 {
-                for y in lo[1] as i64..=hi[1] as i64 {
-                    for z in lo[2] as i64..=hi[2] as i64 {
-                        push(self.bucket([x as i32, y as i32, z as i32]));
+        // A row's buckets follow one another, past the last to the first
+        let last_of_row = span(0) as u32 - 1;
+        let list = |push: &mut dyn FnMut(Run)| {
+            for y in lo[1] as i64..=hi[1] as i64 {
+                for z in lo[2] as i64..=hi[2] as i64 {
+                    let first = self.bucket([lo[0], y as i32, z as i32]);
+                    match first.checked_add(last_of_row).filter(|&last| last <= self.mask) {
+                        Some(last) => push((first, last)),
+                        None => {
+                            push((first, self.mask));
+                            push((0, last_of_row - (self.mask - first) - 1));
+                        }
                     }
                 }
             }
         };
-        Some(if cells as usize <= FEW {
+        // Two runs a row at most
+        let rows = span(1) * span(2);
+        Some(if rows as usize * 2 <= FEW {
             let mut len = 0;
-            list(&mut |b| {
-                few[len] = b;
+            list(&mut |run| {
+                few[len] = run;
                 len += 1;
             });
-            let len = sort_dedup(&mut few[..len]);
+            let len = sort_merge(&mut few[..len]);
             Touched::Few(&few[..len])
         } else {
-            let mut ids = Vec::with_capacity(cells as usize);
-            list(&mut |b| ids.push(b));
-            let len = sort_dedup(&mut ids);
-            ids.truncate(len);
-            Touched::Many(ids)
+            let mut runs = Vec::with_capacity(rows as usize * 2);
+            list(&mut |run| runs.push(run));
+            let len = sort_merge(&mut runs);
+            runs.truncate(len);
+            Touched::Many(runs)
         })
     }
 
-    /// The point ranges of the touched buckets, empty ones left out.
+    /// The point ranges of the touched runs, empty ones left out.
     pub(super) fn ranges<'a>(&'a self, touched: &'a Touched) -> impl Iterator<Item = (usize, usize)> + 'a {
-        let ids: &[u32] = match touched {
-            Touched::Few(ids) => ids,
-            Touched::Many(ids) => ids,
+        let runs: &[Run] = match touched {
+            Touched::Few(runs) => runs,
+            Touched::Many(runs) => runs,
             Touched::All => &[],
         };
         let all = matches!(touched, Touched::All).then_some((0, self.len()));
-        let listed = ids.iter().map(|&b| (self.starts[b as usize] as usize, self.starts[b as usize + 1] as usize));
+        let listed = runs
+            .iter()
+            .map(|&(first, last)| (self.starts[first as usize] as usize, self.starts[last as usize + 1] as usize));
         all.into_iter().chain(listed).filter(|(start, end)| start < end)
     }
 }
@@ -288,13 +315,17 @@ pub(super) fn fill_columns<T: Sync, const C: usize>(
     });
 }
 
-/// Sort `ids` and move each distinct one to the front; how many there are.
-fn sort_dedup(ids: &mut [u32]) -> usize {
-    ids.sort_unstable();
+/// Sort `runs` and join those that overlap or meet (rows whose cells hash
+/// to the same buckets), each joined run to the front; how many there are.
+fn sort_merge(runs: &mut [Run]) -> usize {
+    runs.sort_unstable();
     let mut len = 0;
-    for i in 0..ids.len() {
-        if i == 0 || ids[i] != ids[len - 1] {
-            ids[len] = ids[i];
+    for i in 0..runs.len() {
+        let (first, last) = runs[i];
+        if len > 0 && first <= runs[len - 1].1.saturating_add(1) {
+            runs[len - 1].1 = runs[len - 1].1.max(last);
+        } else {
+            runs[len] = (first, last);
             len += 1;
         }
     }
@@ -357,6 +388,36 @@ pub(super) mod tests {
         }
     }
 
+    /// On a grid of a few buckets, rows of cells wrap past the last bucket
+    /// and fall on each other's buckets: the runs a query lists are still
+    /// sorted and apart, and it finds each point once.
+    #[test]
+    fn runs_that_wrap_and_overlap_are_joined() {
+        let mut s = Sampler::new(5, 0, 17);
+        let (mut wrapped, mut joined) = (0, 0);
+        for n in [3, 6, 9, 17] {
+            let points = scattered(n, 2.0, n as u64);
+            let grid = PointGrid::build(&points, |&p| p, 0.3);
+            for _ in 0..300 {
+                let point = Vec3::new(s.next_f32(), s.next_f32(), s.next_f32()) * 2.4 - 0.2;
+                let radius = s.next_f32() * 0.5;
+                assert_eq!(within(&grid, point, radius), brute_force(&points, point, radius), "{n} points, {point}");
+                let mut few = [(0, 0); FEW];
+                if let Some(Touched::Few(runs)) = grid.touched(point, radius, &mut few) {
+                    assert!(runs.iter().all(|&(first, last)| first <= last && last <= grid.mask));
+                    assert!(runs.windows(2).all(|w| w[1].0 > w[0].1 + 1), "apart: {runs:?}");
+                    // Rows of more cells than the runs' buckets overlapped or wrapped
+                    let (lo, hi) = grid.cell_box(point, radius).expect("a box");
+                    let span = |axis: usize| (hi[axis] - lo[axis] + 1) as u32;
+                    let buckets: u32 = runs.iter().map(|&(first, last)| last - first + 1).sum();
+                    joined += (buckets < span(0) * span(1) * span(2)) as u32;
+                    wrapped += (grid.bucket(lo) + span(0) - 1 > grid.mask) as u32;
+                }
+            }
+        }
+        assert!(wrapped >= 10 && joined >= 50, "wrapped {wrapped}, joined {joined}");
+    }
+
     /// A small query on the floor the points lie lowest on (a VCM merge
     /// on gap-room's floor) touches that floor's cells alone, not also the
     /// empty ones below it.
@@ -371,9 +432,10 @@ pub(super) mod tests {
             let inside = |s: &mut Sampler| s.next_f32().mul_add(0.4, 0.3) + (s.next_f32() * 9.0).floor();
             let (x, z) = (inside(&mut s), inside(&mut s));
             let point = Vec3::new(grid.origin.x + x * cell, 0.0, grid.origin.z + z * cell);
-            let mut few = [0; FEW];
-            let Some(Touched::Few(ids)) = grid.touched(point, cell * 0.25, &mut few) else { panic!("no bucket list") };
-            assert_eq!(ids.len(), 1, "{point}");
+            let mut few = [(0, 0); FEW];
+            let Some(Touched::Few(runs)) = grid.touched(point, cell * 0.25, &mut few) else { panic!("no bucket list") };
+            assert_eq!(runs.len(), 1, "{point}");
+            assert_eq!(runs[0].0, runs[0].1, "one cell along x: {point}");
         }
     }
 

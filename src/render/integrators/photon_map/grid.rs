@@ -64,7 +64,7 @@ impl PhotonGrid {
     /// count, and each one's index handed to `each`, in an order fixed by
     /// the photons and the query alone.
     pub fn gather_front(&self, point: Vec3, radius: f32, facing: Vec3, mut each: impl FnMut(usize)) -> FrontSum {
-        let mut few = [0; FEW];
+        let mut few = [(0, 0); FEW];
         let Some(touched) = self.points.touched(point, radius, &mut few) else { return FrontSum::default() };
         let query = Query { point, bound: radius * radius, facing };
         #[cfg(target_arch = "x86_64")]
