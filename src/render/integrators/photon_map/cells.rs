@@ -1,8 +1,9 @@
 //! A hash grid over points, for queries within a radius: cells of a chosen
 //! width, each hashed to a bucket, the points counting-sorted by bucket
 //! (`reorder::by_key`, linear time) into one column per coordinate. A query
-//! lists the buckets its radius box touches, each once, and tests their
-//! points eight at a time. SPPM's photon grid (`grid`) and VCM's merges
+//! lists the buckets its radius box touches, each once, as runs (a row of
+//! cells along x hashes to consecutive buckets), and tests each run's
+//! stretch of points eight at a time. SPPM's photon grid (`grid`) and VCM's merges
 //! (`bidir::merging`) keep what they read of each point beside the columns,
 //! in the same order (`in_grid_order_into`), so a query reads nothing out of
 //! sequence.
