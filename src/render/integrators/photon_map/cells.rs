@@ -3,10 +3,10 @@
 //! (`reorder::by_key`, linear time) into one column per coordinate. A query
 //! lists the buckets its radius box touches, each once, as runs (a row of
 //! cells along x hashes to consecutive buckets), and tests each run's
-//! stretch of points eight at a time. SPPM's photon grid (`grid`) and VCM's merges
-//! (`bidir::merging`) keep what they read of each point beside the columns,
-//! in the same order (`in_grid_order_into`), so a query reads nothing out of
-//! sequence.
+//! stretch of points eight at a time. SPPM's photon grid (`grid`) and
+//! VCM's merges (`bidir::merging`) keep what they read of each point beside
+//! the columns, in the same order (`in_grid_order_into`), so a query reads
+//! nothing out of sequence.
 //!
 //! Chosen over the kd-tree by measurement for both: an SPPM query finds
 //! hundreds of photons, for each of which the kd walk pays a branch and a
