@@ -155,8 +155,8 @@ struct Joins {
     contribution_places: Vec<u32>,
 }
 
-/// Vertices a light subpath keeps, on the presets, for a few more than most
-/// (gap-room 3.25 a path).
+/// Room reserved per light subpath for the vertices it keeps: a little
+/// more than most presets' paths keep (gap-room's 3.25 on average).
 const EXPECTED_VERTICES: usize = 4;
 
 /// Joins traced together: a few batches of eight.
@@ -329,8 +329,8 @@ impl<'w> Flights<'_, 'w> {
         // Which path made each vertex, splat and contribution: its place among `indices`
         let mut places = Vec::new();
         if self.ctx.keeps_vertices() {
-            // Room for the vertices of most passes at once: grown from
-            // nothing, their copies were 2% of a VCM render's instructions
+            // Room for most chunks' vertices at once: grown from nothing,
+            // their copies were 2% of a VCM render's instructions
             let expected = (indices.end - indices.start) as usize * EXPECTED_VERTICES;
             (out.vertices, places) = (Vec::with_capacity(expected), Vec::with_capacity(expected));
         }
