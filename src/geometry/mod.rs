@@ -11,7 +11,7 @@ pub mod real;
 pub mod sphere;
 mod triangle;
 
-pub use cull::{beyond, Crossing, CullPlane, TriangleCull};
+pub use cull::{beyond, Crossing, CullEdges, CullPlane, TriangleCull};
 pub use frame::{frame_from_z, to_world, Frame};
 pub use plane::intersect_plane;
 pub(crate) use plane::{plane_exit_of, plane_exit_t, plane_hit, plane_point_of, plane_t, plane_t_of};

@@ -22,18 +22,25 @@ pub(super) struct GlossyLanes {
 }
 
 impl GlossyLanes {
-    /// The lanes of `alive` on a Phong or Blinn–Phong surface.
+    /// The lanes of `alive` on a Phong or Blinn–Phong surface; `color` is
+    /// each lane's surface colour (the diffuse lobe's).
     #[inline(always)]
-    pub(super) fn new(surface: &[&Surface; LANES], code: F8, alive: M8) -> Self {
-        GlossyLanes {
-            phong: code.eq(F8::splat(PHONG)).and(alive),
-            blinn_phong: code.eq(F8::splat(BLINN_PHONG)).and(alive),
-            kd: V8::from_fn(|i| surface[i].color),
-            ks: V8::from_fn(|i| surface[i].specular),
-            exponent: F8::from_fn(|i| surface[i].exponent),
-            diffuse_probability: F8::from_fn(|i| surface[i].diffuse_probability),
-            normalisation: F8::from_fn(|i| surface[i].normalisation),
-        }
+    pub(super) fn new(surface: &[&Surface; LANES], code: F8, color: V8, alive: M8) -> Self {
+        let phong = code.eq(F8::splat(PHONG)).and(alive);
+        let blinn_phong = code.eq(F8::splat(BLINN_PHONG)).and(alive);
+        // The lobes' parameters gathered only where a lane is glossy: every
+        // bounce of a scene without a glossy surface gathered them for
+        // nothing (2.7% of smallpt's instructions)
+        let (ks, exponent, diffuse_probability, normalisation) = match phong.or(blinn_phong).any() {
+            true => (
+                V8::from_fn(|i| surface[i].specular),
+                F8::from_fn(|i| surface[i].exponent),
+                F8::from_fn(|i| surface[i].diffuse_probability),
+                F8::from_fn(|i| surface[i].normalisation),
+            ),
+            false => (V8::splat(Vec3::ZERO), F8::splat(0.0), F8::splat(0.0), F8::splat(0.0)),
+        };
+        GlossyLanes { phong, blinn_phong, kd: color, ks, exponent, diffuse_probability, normalisation }
     }
 
     #[inline(always)]

@@ -32,7 +32,7 @@ use crate::faults::{self, Fault};
 use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_finish_of, watertight_range_of, RayShear};
 use crate::geometry::{gamma, intersect_triangle, offset_origin, Ray, SurfaceHit, Triangle};
-use crate::geometry::{plane_exit_of, plane_point_of, plane_t_of, Crossing};
+use crate::geometry::{plane_exit_of, plane_point_of, plane_t_of, Crossing, CullEdges, CullPlane};
 use crate::render::world::bsdf::{blinn_normalisation, Bsdf, Transport};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
@@ -124,9 +124,10 @@ pub struct PathLanes {
     spheres: Vec<SphereInfo>,
     planes: Vec<PlaneInfo>,
     triangles: Vec<Triangle>,
-    /// Which run of triangles in one plane each belongs to
-    /// (`Triangle::share_planes`): a run's rays cross its plane once.
-    plane_runs: Vec<u32>,
+    /// What the cull reads of each triangle, in one record (read from the
+    /// triangle and a list of runs beside it, its loads and bounds checks
+    /// were 5% of gap-room's instructions).
+    triangle_culls: Vec<LaneCull>,
     /// Each triangle's light plane (`World::light_plane`): a shadow ray
     /// toward a light on a triangle skips the triangles of its plane.
     triangle_planes: Vec<u32>,
@@ -241,7 +242,7 @@ impl PathLanes {
             spheres,
             planes,
             triangles: world.triangles.iter().map(|(triangle, _)| *triangle).collect(),
-            plane_runs: plane_runs(&world.triangles),
+            triangle_culls: lane_culls(&world.triangles),
             triangle_planes: world.light_plane.clone(),
             surfaces,
             lights: LaneLights::new(world),
@@ -602,13 +603,13 @@ impl PathLanes {
         let first_triangle = first_plane + self.planes.len() as f32;
         let (mut triangle_point, mut triangle_normal, mut triangle_error) =
             (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
-        let shear = ray_shear_of(origin, direction);
         let mut crossing = RunCrossing::new();
         for (j, triangle) in self.triangles.iter().enumerate() {
-            let near = self.cull(j, &mut crossing, active, origin, direction, t_hit).0;
+            let near = Self::cull(&self.triangle_culls[j], &mut crossing, active, origin, direction, t_hit).0;
             if !near.any() {
                 continue;
             }
+            let shear = crossing.shear(origin, direction);
             let (hits, t, point, error) = Self::triangle_hits(triangle, near, origin, direction, &shear, t_hit);
             if hits.any() {
                 t_hit = hits.select(t, t_hit);
@@ -739,16 +740,22 @@ impl PathLanes {
     /// test). `crossing` keeps where the rays cross the plane of the run
     /// the last triangle asked about.
     #[inline(always)]
-    fn cull(&self, j: usize, crossing: &mut RunCrossing, mask: M8, origin: V8, direction: V8, t_max: F8) -> (M8, M8) {
-        let triangle = &self.triangles[j];
-        if !mask.any() || triangle.is_degenerate() {
+    fn cull(
+        triangle: &LaneCull,
+        crossing: &mut RunCrossing,
+        mask: M8,
+        origin: V8,
+        direction: V8,
+        t_max: F8,
+    ) -> (M8, M8) {
+        if !mask.any() || triangle.degenerate {
             return (M8::NONE, M8::NONE);
         }
-        if crossing.run != self.plane_runs[j] {
-            *crossing =
-                RunCrossing { run: self.plane_runs[j], at: Crossing::of(origin, direction, &triangle.cull.plane) };
+        if crossing.run != triangle.run {
+            crossing.run = triangle.run;
+            crossing.at = Crossing::of(origin, direction, &triangle.plane);
         }
-        let (turned_away, surely) = crossing.at.test(&triangle.cull.edges.splat(), t_max);
+        let (turned_away, surely) = crossing.at.test(&triangle.edges.load(), t_max);
         (mask.and_not(turned_away), mask.and(surely))
     }
 
@@ -791,7 +798,6 @@ impl PathLanes {
         }
         // Triangles where the ray may reach them, but those in the plane of
         // the light triangle a ray ends on
-        let shear = ray_shear_of(origin, direction);
         let mut crossing = RunCrossing::new();
         for (j, (triangle, plane)) in self.triangles.iter().zip(&self.triangle_planes).enumerate() {
             let aimed_at = match skips {
@@ -800,10 +806,11 @@ impl PathLanes {
                 Skips::Lanes { planes, .. } => M8::from_fn(|i| planes[i] == Some(*plane)),
             };
             let open = mask.and_not(blocked).and_not(aimed_at);
-            let (near, surely) = self.cull(j, &mut crossing, open, origin, direction, t_max);
+            let (near, surely) = Self::cull(&self.triangle_culls[j], &mut crossing, open, origin, direction, t_max);
             blocked = blocked.or(surely);
             let near = near.and_not(surely);
             if near.any() {
+                let shear = crossing.shear(origin, direction);
                 blocked = blocked.or(Self::triangle_hits(triangle, near, origin, direction, &shear, t_max).0);
             }
         }
@@ -867,10 +874,51 @@ enum Skips {
     },
 }
 
-/// Where eight rays cross the plane of a run of triangles.
+/// What `cull` reads of a triangle.
+#[derive(Clone, Debug)]
+struct LaneCull {
+    /// Its edges, each coefficient splat into eight lanes, read straight
+    /// into the test: splat afresh, they were a fifth of the cull's
+    /// instructions.
+    edges: LaneEdges,
+    plane: CullPlane,
+    /// Which run of triangles in one plane it belongs to
+    /// (`Triangle::share_planes`): a run's rays cross its plane once.
+    run: u32,
+    degenerate: bool,
+}
+
+/// A triangle's `CullEdges`, each coefficient in every lane.
+#[derive(Clone, Debug)]
+#[repr(align(32))]
+struct LaneEdges([[[f32; LANES]; 3]; 3]);
+
+impl LaneEdges {
+    fn of(edges: &CullEdges) -> Self {
+        LaneEdges(edges.0.map(|edge| edge.map(|c| [c; LANES])))
+    }
+
+    #[inline(always)]
+    fn load(&self) -> [[F8; 3]; 3] {
+        // Written out: `map`'s closures are left out of line, without AVX2
+        let [[a0, b0, c0], [a1, b1, c1], [a2, b2, c2]] = &self.0;
+        [
+            [F8::load(a0), F8::load(b0), F8::load(c0)],
+            [F8::load(a1), F8::load(b1), F8::load(c1)],
+            [F8::load(a2), F8::load(b2), F8::load(c2)],
+        ]
+    }
+}
+
+/// Where eight rays cross the plane of a run of triangles, and their
+/// shear for the watertight test once one needs it.
 struct RunCrossing {
     run: u32,
     at: Crossing<F8>,
+    /// Worked out for every batch before the triangles (a division and the
+    /// axes' selects), it was 3.5% of the instructions of smallpt, which
+    /// has none; only a batch the cull lets through needs it.
+    shear: Option<RayShear<F8>>,
 }
 
 impl RunCrossing {
@@ -878,18 +926,34 @@ impl RunCrossing {
     #[inline(always)]
     fn new() -> Self {
         let zero = F8::splat(0.0);
-        RunCrossing { run: u32::MAX, at: Crossing { t: zero, u: zero, v: zero, slack: zero } }
+        RunCrossing { run: u32::MAX, at: Crossing { t: zero, u: zero, v: zero, slack: zero }, shear: None }
+    }
+
+    /// The rays' shear, worked out the first time it is asked for.
+    #[inline(always)]
+    fn shear(&mut self, origin: V8, direction: V8) -> RayShear<F8> {
+        // A match, not `get_or_insert_with`: a closure would lose AVX2
+        match self.shear {
+            Some(shear) => shear,
+            None => *self.shear.insert(ray_shear_of(origin, direction)),
+        }
     }
 }
 
-/// Each triangle's run of triangles in one plane, counted from 0
-/// (`Triangle::share_planes` gave a run one plane).
-fn plane_runs(triangles: &[(Triangle, u32)]) -> Vec<u32> {
+/// What the cull reads of each triangle, its run of triangles in one plane
+/// counted from 0 (`Triangle::share_planes` gave a run one plane).
+fn lane_culls(triangles: &[(Triangle, u32)]) -> Vec<LaneCull> {
     let mut run = 0;
     (0..triangles.len())
         .map(|j| {
-            run += (j > 0 && triangles[j].0.cull.plane != triangles[j - 1].0.cull.plane) as u32;
-            run
+            let triangle = &triangles[j].0;
+            run += (j > 0 && triangle.cull.plane != triangles[j - 1].0.cull.plane) as u32;
+            LaneCull {
+                edges: LaneEdges::of(&triangle.cull.edges),
+                plane: triangle.cull.plane,
+                run,
+                degenerate: triangle.is_degenerate(),
+            }
         })
         .collect()
 }

@@ -44,13 +44,14 @@ impl<'a> LaneSurfaces<'a> {
         let surface: [&Surface; LANES] = lanes::each(|i| &surfaces[shape[i] as usize]);
         let code = F8::from_fn(|i| surface[i].kind);
         let kind = |k: f32| code.eq(F8::splat(k)).and(alive);
+        let color = V8::from_fn(|i| surface[i].color);
         LaneSurfaces {
             lambert: kind(LAMBERT),
             mirror: kind(MIRROR),
             glass: kind(GLASS),
             emissive: kind(EMITTER),
-            glossy: GlossyLanes::new(&surface, code, alive),
-            color: V8::from_fn(|i| surface[i].color),
+            glossy: GlossyLanes::new(&surface, code, color, alive),
+            color,
             surface,
         }
     }
