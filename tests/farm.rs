@@ -181,6 +181,12 @@ fn the_commands_shard_merge_and_write_the_farms_scripts() {
     assert!(text.contains("merged 2 of 2 shards") && text.contains("6 samples per pixel"), "{text}");
     let (code, text) = run(&["compare", "merged.exr", "whole.exr", "--max-rel-mse", "1e-9"]);
     assert_eq!(code, Some(0), "{text}");
+    // Images of other sizes are refused, each size as width×height
+    let (code, text) = run(&["render", &scene, "-o", "small.exr", "--spp", "1", "--width", "8", "--height", "4"]);
+    assert_eq!(code, Some(0), "{text}");
+    let (code, text) = run(&["compare", "small.exr", "whole.exr"]);
+    assert_eq!(code, Some(1), "{text}");
+    assert!(text.contains("small.exr is 8×4 and") && text.contains("whole.exr is 24×18"), "{text}");
     let (code, text) = run(&["merge", "part-0.exr", "-o", "half.exr"]);
     assert_eq!((code, text.contains("shards 1 of 2 are missing")), (Some(1), true), "{text}");
     let (code, text) = run(&["render", &scene, "-o", "x.exr", "--shard", "0/2", "--time", "1"]);

@@ -121,8 +121,8 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
             image.width,
             image.height,
             args.reference.display(),
-            reference.height,
-            reference.width
+            reference.width,
+            reference.height
         );
     }
     let relative = rel_mse(&image, &reference, RelMseOptions::default())?;
