@@ -11,9 +11,13 @@
 //! crossing, of the edges and of the watertight test itself on any ray the
 //! tests run here, so a ray that lands on the triangle is never turned away
 //! (and a mesh stays watertight: both sides of a shared edge let its rays
-//! through). For shadow rays it also says which lanes land inside by more
-//! than the slack, well within their segment: those are blocked without
-//! the watertight test, which could only agree.
+//! through). It also says which lanes land inside by more than the slack,
+//! well within their segment: the watertight test could only agree, so a
+//! shadow ray there is blocked without it, and a ray looking for its
+//! nearest hit takes the crossing, put back onto the plane, as its hit
+//! (`Crossing::hit_point`). Only rays near an edge pay for the watertight
+//! test (gap-room's path tracing, 128×96, 8 spp: 205.8 M → 201.6 M
+//! instructions, 0.96 of the time).
 //!
 //! One case it decides differently: a triangle seen from more than about
 //! a thousand times its size, whose watertight edge functions (products
@@ -25,6 +29,7 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
+use super::plane::plane_point_of;
 use super::real::{Mask, Real, V3};
 
 /// The slack, relative to the magnitudes the crossing is computed from
@@ -145,6 +150,21 @@ impl<R: Real> Crossing<R> {
             sure = sure.and(e.gt(slack));
         }
         (turned_away, sure)
+    }
+}
+
+impl<R: Real> Crossing<R> {
+    /// Where rays sure to hit a triangle of `plane` (`test`'s second mask)
+    /// meet it: at the crossing, the point put back onto the plane as a
+    /// plane's hit is (`plane_point_of`), and a bound on its error that
+    /// also covers the triangle lying off the plane it shares by rounding
+    /// (`Triangle::holds_in_plane`'s 4 ulps of its scale, the plane's own
+    /// rounding as much again).
+    #[inline(always)]
+    pub fn hit_point(&self, origin: V3<R>, direction: V3<R>, plane: &CullPlane) -> (V3<R>, R) {
+        let normal = V3::new(R::splat(plane.normal.x), R::splat(plane.normal.y), R::splat(plane.normal.z));
+        let (point, error) = plane_point_of(origin, direction, normal, R::splat(plane.offset), self.t);
+        (point, error + R::splat(8.0 * f32::EPSILON * plane.scale))
     }
 }
 

@@ -78,15 +78,24 @@ impl Triangle {
 /// pbrt-v4): shear the triangle into the ray's space so that rays through
 /// shared edges and vertices hit exactly one side or both, never neither.
 /// Rays that cross the plane away from the triangle are turned away first
-/// (`cull`).
+/// (`cull`), and those that cross it well inside take the crossing as
+/// their hit: the watertight test is for the rays near an edge.
 #[inline]
 pub fn intersect_triangle(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<SurfaceHit> {
     if triangle.is_degenerate() {
         return None;
     }
-    let crossing = Crossing::<f32>::of(ray.origin.into(), ray.direction.into(), &triangle.cull.plane);
-    if crossing.test(&triangle.cull.edges.splat(), t_max).0 {
+    let (origin, direction) = (ray.origin.into(), ray.direction.into());
+    let crossing = Crossing::<f32>::of(origin, direction, &triangle.cull.plane);
+    let (turned_away, sure) = crossing.test(&triangle.cull.edges.splat(), t_max);
+    if turned_away {
         return None;
+    }
+    // Inside every edge and the segment by more than the slack: the
+    // watertight test could only agree, and its t and point are no better
+    if sure {
+        let (point, error) = crossing.hit_point(origin, direction, &triangle.cull.plane);
+        return Some(SurfaceHit { t: crossing.t, point: point.into(), normal: triangle.normal, error });
     }
     watertight(ray, triangle, t_max)
 }
@@ -328,7 +337,8 @@ mod tests {
     /// origin, seen from 1e-3 to 1e3 of their size away, rays aimed at
     /// vertices, edge points and interiors. It turns away rays sent the
     /// other way, and rays that cross the plane beside an edge (those not
-    /// grazing it); a ray it calls sure, the watertight test hits.
+    /// grazing it); a ray it calls sure, the watertight test hits, and its
+    /// hit (the crossing) lies within its error bound of the triangle.
     #[test]
     fn the_cull_never_turns_away_a_hit() {
         let mut state = 0x2545_f491_4f6c_dd1du64;
@@ -343,6 +353,7 @@ mod tests {
             crossing.test(&tri.cull.edges.splat(), f32::INFINITY)
         };
         let (mut hits, mut sure, mut away, mut away_turned, mut beside, mut beside_turned) = (0, 0, 0, 0, 0, 0);
+        let mut worst = 0f64;
         for case in 0..40_000 {
             let scale = 10f32.powf(uniform() * 12.0 - 6.0);
             let mut point = || Vec3::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5) * 2.0;
@@ -366,6 +377,18 @@ mod tests {
             if surely {
                 sure += 1;
                 assert!(hit, "case {case}: sure of a ray the watertight test misses, {tri:?}, ray {ray:?}");
+                // Its hit is the crossing, off the triangle's exact plane
+                // (f64) by no more than the bound a spawned ray clears
+                let found = intersect_triangle(&ray, &tri, f32::INFINITY).expect("a sure hit");
+                let [a64, b64, c64] = tri.vertices.map(|v| v.as_dvec3());
+                let normal = (b64 - a64).cross(c64 - a64).normalize();
+                let off_plane = normal.dot(found.point.as_dvec3() - a64).abs();
+                assert!(
+                    off_plane <= found.error as f64,
+                    "case {case}: {off_plane} off the plane, bound {}",
+                    found.error
+                );
+                worst = worst.max(off_plane / found.error as f64);
             }
             // Away from the triangle, for rays not grazing its plane from
             // within a few sizes of it (further off, or grazing, the slack
@@ -387,6 +410,8 @@ mod tests {
             }
         }
         assert!(hits > 20_000 && sure > 5_000, "{hits} hits, {sure} sure");
+        // The bound is not so loose that it could not fail
+        assert!(worst > 1e-2, "the sure hits' points lie within {worst:e} of their bound");
         assert!(away > 5_000 && away_turned == away, "{away_turned} of {away} rays sent away turned away");
         assert!(
             beside > 3_000 && beside_turned == beside,

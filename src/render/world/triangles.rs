@@ -36,7 +36,8 @@ struct Verdict {
     /// Lanes hit within (0, t_max), by the f32 test.
     hit: u32,
     /// Lanes whose crossing lies inside by more than the cull's slack
-    /// (`Crossing::test`): a shadow ray there is blocked.
+    /// (`Crossing::test`): a shadow ray there is blocked, and the crossing
+    /// is the hit.
     sure: u32,
     /// Where the ray crosses each lane's plane, and the slack.
     crossing: Crossing<Vec4>,
@@ -125,12 +126,25 @@ impl TriangleLanes {
         let shear = RayShear::of_one_ray(ray.origin, ray.direction);
         for (g, group) in self.groups.iter().enumerate() {
             let Some(verdict) = Self::verdict(group, ray, &shear, best_t) else { continue };
-            let (mut lanes, mut narrowed) = (verdict.hit | verdict.scalar, false);
+            let (mut lanes, mut narrowed) = (verdict.hit | verdict.scalar | verdict.sure, false);
             while lanes != 0 {
                 let lane = lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
                 let id = self.ids[g * 4 + lane];
                 let triangle = &triangles[id as usize].0;
+                let (crossing_t, slack) =
+                    (verdict.crossing.t.to_array()[lane], verdict.crossing.slack.to_array()[lane]);
+                // Sure against the group's t_max, and still against a nearer
+                // one: the crossing is the hit, as `intersect_triangle` takes it
+                if verdict.sure & (1 << lane) != 0 && (!narrowed || crossing_t + slack < best_t) {
+                    let crossing = Crossing { t: crossing_t, u: 0.0, v: 0.0, slack };
+                    let (point, error) =
+                        crossing.hit_point(ray.origin.into(), ray.direction.into(), &triangle.cull.plane);
+                    (best_t, narrowed) = (crossing_t, true);
+                    found =
+                        Some((id, SurfaceHit { t: crossing_t, point: point.into(), normal: triangle.normal, error }));
+                    continue;
+                }
                 if verdict.scalar & (1 << lane) != 0 {
                     if let Some(hit) = intersect_triangle(ray, triangle, best_t) {
                         (best_t, narrowed) = (hit.t, true);
@@ -138,13 +152,14 @@ impl TriangleLanes {
                     }
                     continue;
                 }
+                if verdict.hit & (1 << lane) == 0 {
+                    continue;
+                }
                 // An earlier lane of this group may have brought t_max
                 // nearer: the scalar loop would test both cull and hit
                 // against it
                 if narrowed {
                     let (t_scaled, det) = (verdict.t_scaled.to_array()[lane], verdict.det.to_array()[lane]);
-                    let (crossing_t, slack) =
-                        (verdict.crossing.t.to_array()[lane], verdict.crossing.slack.to_array()[lane]);
                     let bound = best_t * det;
                     if beyond(crossing_t, slack, best_t)
                         || (det < 0.0 && t_scaled < bound)

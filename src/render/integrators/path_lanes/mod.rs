@@ -598,14 +598,23 @@ impl PathLanes {
                 k = k + 1.0;
             }
         }
-        // Triangles last, as both do: the watertight test in the lanes
-        // the cull lets through
+        // Triangles last, as both do: the crossing where the cull is sure,
+        // the watertight test in the other lanes it lets through
         let first_triangle = first_plane + self.planes.len() as f32;
         let (mut triangle_point, mut triangle_normal, mut triangle_error) =
             (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
         let mut crossing = RunCrossing::new();
         for (j, triangle) in self.triangles.iter().enumerate() {
-            let near = Self::cull(&self.triangle_culls[j], &mut crossing, active, origin, direction, t_hit).0;
+            let (near, sure) = Self::cull(&self.triangle_culls[j], &mut crossing, active, origin, direction, t_hit);
+            if sure.any() {
+                let (point, error) = crossing.at.hit_point(origin, direction, &triangle.cull.plane);
+                t_hit = sure.select(crossing.at.t, t_hit);
+                index = sure.select(F8::splat(first_triangle + j as f32), index);
+                triangle_point = sure.select_v(point, triangle_point);
+                triangle_normal = sure.select_v(V8::splat(triangle.normal), triangle_normal);
+                triangle_error = sure.select(error, triangle_error);
+            }
+            let near = near.and_not(sure);
             if !near.any() {
                 continue;
             }
@@ -1079,10 +1088,11 @@ mod tests {
         assert!(expected.iter().filter(|v| v.max_element() > 0.0).count() > 200, "samples carried light");
     }
 
-    /// The lanes' watertight test is `intersect_triangle`, bit for bit: on
-    /// random rays, and on rays straight down onto a quad's edges and
-    /// vertices, where edge functions are exactly zero and the scalar code
-    /// redoes them in f64.
+    /// The lanes' triangle test (the crossing where the cull is sure, the
+    /// watertight test in the other lanes it lets through) is
+    /// `intersect_triangle`, bit for bit: on random rays, and on rays
+    /// straight down onto a quad's edges and vertices, where edge functions
+    /// are exactly zero and the scalar code redoes them in f64.
     #[test]
     fn triangle_hits_are_the_scalar_ones() {
         use crate::render::world::rng::Sampler;
@@ -1102,17 +1112,22 @@ mod tests {
             let target = Vec3::new(rng.next_f32() * 1.4 - 0.2, rng.next_f32() * 1.4 - 0.2, 0.0);
             rays.push((origin, (target - origin).normalize(), 10.0));
         }
-        let (mut on_edges, mut hits_seen, mut misses_seen) = (0, 0, 0);
+        let (mut on_edges, mut hits_seen, mut misses_seen, mut sure_seen) = (0, 0, 0, 0);
         for triangle in &triangles {
             for batch in rays.chunks(LANES) {
                 let origin = V8::from_fn(|i| batch[i].0);
                 let direction = V8::from_fn(|i| batch[i].1);
                 let t_max = F8::from_fn(|i| batch[i].2);
                 let crossing = Crossing::of(origin, direction, &triangle.cull.plane);
-                let near = !crossing.test(&triangle.cull.edges.splat(), t_max).0;
+                let (turned_away, sure) = crossing.test(&triangle.cull.edges.splat(), t_max);
+                let near = (!turned_away).and_not(sure);
                 let shear = ray_shear_of(origin, direction);
                 let (hits, t, point, error) =
                     PathLanes::triangle_hits(triangle, near, origin, direction, &shear, t_max);
+                let (sure_point, sure_error) = crossing.hit_point(origin, direction, &triangle.cull.plane);
+                let (hits, t) = (hits.or(sure), sure.select(crossing.t, t));
+                let (point, error) = (sure.select_v(sure_point, point), sure.select(sure_error, error));
+                sure_seen += sure.count();
                 for (i, &(o, d, t_max)) in batch.iter().enumerate() {
                     let vertices = triangle.vertices.map(crate::geometry::real::V3::from);
                     on_edges += edges_of(shear_of(o.into(), d.into(), vertices).0).contains(&0.0) as u32;
@@ -1130,5 +1145,6 @@ mod tests {
             }
         }
         assert!(on_edges > 50 && hits_seen > 300 && misses_seen > 300, "{on_edges} {hits_seen} {misses_seen}");
+        assert!(sure_seen > 100 && hits_seen >= sure_seen + 10, "{sure_seen} of {hits_seen} hits by the crossing");
     }
 }
