@@ -15,7 +15,7 @@
 //! well within their segment: the watertight test could only agree, so a
 //! shadow ray there is blocked without it, and a ray looking for its
 //! nearest hit takes the crossing, put back onto the plane, as its hit
-//! (`Crossing::hit_point`). Only rays near an edge pay for the watertight
+//! (`CullPlane::hit_point`). Only rays near an edge pay for the watertight
 //! test (gap-room's path tracing, 128×96, 8 spp: 205.8 M → 201.6 M
 //! instructions, 0.96 of the time).
 //!
@@ -63,6 +63,21 @@ pub struct CullEdges(pub [[f32; 3]; 3]);
 pub struct TriangleCull {
     pub plane: CullPlane,
     pub edges: CullEdges,
+}
+
+impl CullPlane {
+    /// Where rays sure to hit a triangle of the plane (`Crossing::test`'s
+    /// second mask) meet it, at their crossing `t`: the point put back onto
+    /// the plane as a plane's hit is (`plane_point_of`), and a bound on its
+    /// error that also covers the triangle lying off the plane it shares by
+    /// rounding (`Triangle::holds_in_plane`'s 4 ulps of its scale, the
+    /// plane's own rounding as much again).
+    #[inline(always)]
+    pub fn hit_point<R: Real>(&self, origin: V3<R>, direction: V3<R>, t: R) -> (V3<R>, R) {
+        let normal = V3::new(R::splat(self.normal.x), R::splat(self.normal.y), R::splat(self.normal.z));
+        let (point, error) = plane_point_of(origin, direction, normal, R::splat(self.offset), t);
+        (point, error + R::splat(8.0 * f32::EPSILON * self.scale))
+    }
 }
 
 impl TriangleCull {
@@ -150,21 +165,6 @@ impl<R: Real> Crossing<R> {
             sure = sure.and(e.gt(slack));
         }
         (turned_away, sure)
-    }
-}
-
-impl<R: Real> Crossing<R> {
-    /// Where rays sure to hit a triangle of `plane` (`test`'s second mask)
-    /// meet it: at the crossing, the point put back onto the plane as a
-    /// plane's hit is (`plane_point_of`), and a bound on its error that
-    /// also covers the triangle lying off the plane it shares by rounding
-    /// (`Triangle::holds_in_plane`'s 4 ulps of its scale, the plane's own
-    /// rounding as much again).
-    #[inline(always)]
-    pub fn hit_point(&self, origin: V3<R>, direction: V3<R>, plane: &CullPlane) -> (V3<R>, R) {
-        let normal = V3::new(R::splat(plane.normal.x), R::splat(plane.normal.y), R::splat(plane.normal.z));
-        let (point, error) = plane_point_of(origin, direction, normal, R::splat(plane.offset), self.t);
-        (point, error + R::splat(8.0 * f32::EPSILON * plane.scale))
     }
 }
 

@@ -94,7 +94,7 @@ pub fn intersect_triangle(ray: &Ray, triangle: &Triangle, t_max: f32) -> Option<
     // Inside every edge and the segment by more than the slack: the
     // watertight test could only agree, and its t and point are no better
     if sure {
-        let (point, error) = crossing.hit_point(origin, direction, &triangle.cull.plane);
+        let (point, error) = triangle.cull.plane.hit_point(origin, direction, crossing.t);
         return Some(SurfaceHit { t: crossing.t, point: point.into(), normal: triangle.normal, error });
     }
     watertight(ray, triangle, t_max)

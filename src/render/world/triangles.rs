@@ -137,9 +137,8 @@ impl TriangleLanes {
                 // Sure against the group's t_max, and still against a nearer
                 // one: the crossing is the hit, as `intersect_triangle` takes it
                 if verdict.sure & (1 << lane) != 0 && (!narrowed || crossing_t + slack < best_t) {
-                    let crossing = Crossing { t: crossing_t, u: 0.0, v: 0.0, slack };
                     let (point, error) =
-                        crossing.hit_point(ray.origin.into(), ray.direction.into(), &triangle.cull.plane);
+                        triangle.cull.plane.hit_point(ray.origin.into(), ray.direction.into(), crossing_t);
                     (best_t, narrowed) = (crossing_t, true);
                     found =
                         Some((id, SurfaceHit { t: crossing_t, point: point.into(), normal: triangle.normal, error }));

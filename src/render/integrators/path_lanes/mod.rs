@@ -607,7 +607,7 @@ impl PathLanes {
         for (j, triangle) in self.triangles.iter().enumerate() {
             let (near, sure) = Self::cull(&self.triangle_culls[j], &mut crossing, active, origin, direction, t_hit);
             if sure.any() {
-                let (point, error) = crossing.at.hit_point(origin, direction, &triangle.cull.plane);
+                let (point, error) = triangle.cull.plane.hit_point(origin, direction, crossing.at.t);
                 t_hit = sure.select(crossing.at.t, t_hit);
                 index = sure.select(F8::splat(first_triangle + j as f32), index);
                 triangle_point = sure.select_v(point, triangle_point);
@@ -1124,7 +1124,7 @@ mod tests {
                 let shear = ray_shear_of(origin, direction);
                 let (hits, t, point, error) =
                     PathLanes::triangle_hits(triangle, near, origin, direction, &shear, t_max);
-                let (sure_point, sure_error) = crossing.hit_point(origin, direction, &triangle.cull.plane);
+                let (sure_point, sure_error) = triangle.cull.plane.hit_point(origin, direction, crossing.t);
                 let (hits, t) = (hits.or(sure), sure.select(crossing.t, t));
                 let (point, error) = (sure.select_v(sure_point, point), sure.select(sure_error, error));
                 sure_seen += sure.count();
