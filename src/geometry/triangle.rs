@@ -419,6 +419,95 @@ mod tests {
         );
     }
 
+    /// Rays leaving the plane of a run of triangles (`cull::leaving`): the
+    /// cull turns away every ray spawned off a hit on the run (from a point
+    /// at least half the run's scale from the origin, as the margin allows),
+    /// and never a ray the watertight test hits. Quads at scales 1e-6 … 1e6,
+    /// their second triangle off the shared plane by up to 3 ulps; the rays
+    /// start from 1/256 to 16 margins off the plane on either side, either
+    /// way, steep or grazing. With no margin a ray starting between the
+    /// plane and the lifted corner, its hit, is turned away; with five times
+    /// the margin, spawned rays are not.
+    #[test]
+    fn rays_leaving_a_plane_are_turned_away_and_never_a_hit() {
+        use crate::geometry::offset_ray_origin;
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let turned_away = |ray: &Ray, tri: &Triangle| {
+            let crossing = Crossing::<f32>::of(ray.origin.into(), ray.direction.into(), &tri.cull.plane);
+            crossing.test(&tri.cull.edges.splat(), f32::INFINITY).0
+        };
+        let point =
+            |uniform: &mut dyn FnMut() -> f32| Vec3::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5) * 2.0;
+        let (mut spawned, mut near, mut hits, mut left) = (0, 0, 0, 0);
+        for case in 0..20_000 {
+            let scale = 10f32.powf(uniform() * 12.0 - 6.0);
+            let corner = point(&mut uniform) * scale * 4.0;
+            let (u, v) = (point(&mut uniform) * scale, point(&mut uniform) * scale);
+            // The fourth corner lifted off the plane by up to 3 of the 4 ulps
+            // a run allows
+            let lift = u.cross(v).normalize_or_zero() * (uniform() * 2.0 - 1.0) * 3.0 * f32::EPSILON;
+            let quad = [corner, corner + u, corner + u + v, corner + v + lift * (corner + u + v).abs().max_element()];
+            let mut run = [Triangle::new(quad[0], quad[1], quad[2]), Triangle::new(quad[0], quad[2], quad[3])];
+            Triangle::share_planes(&mut run.iter_mut().collect::<Vec<_>>());
+            if run[0].is_degenerate() || run[1].cull.plane != run[0].cull.plane {
+                continue;
+            }
+            let plane = run[0].cull.plane;
+            let [a, b, c] = run[1].vertices;
+            let (b1, b2) = (uniform(), uniform());
+            let (b1, b2) = if b1 + b2 > 1.0 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
+            let on = a + (b - a) * b1 + (c - a) * b2;
+            let side = if uniform() < 0.5 { 1.0 } else { -1.0 };
+            // Half of them within a degree of the normal (where the
+            // watertight test finds the triangle lying a few ulps off the
+            // plane), half down to grazing (a cosine of 1e-4)
+            let cos = if case % 2 == 0 { 1.0 - 1e-4 * uniform() } else { 10f32.powf(-4.0 * uniform()) };
+            let along = plane
+                .normal
+                .cross(point(&mut uniform))
+                .try_normalize()
+                .unwrap_or(plane.normal.any_orthonormal_vector());
+            let away = (plane.normal * (side * cos) + along * (1.0 - cos * cos).sqrt()).normalize();
+            // Spawned off a hit, the way every integrator spawns its rays
+            let arriving = Ray::new(on + away * scale, -away);
+            if let Some(hit) = intersect_triangle(&arriving, &run[1], f32::INFINITY) {
+                let ray = Ray::new(offset_ray_origin(hit.point, hit.error, hit.normal, away), away);
+                if on.abs().max_element() >= plane.scale * 0.5 {
+                    spawned += 1;
+                    for tri in &run {
+                        assert!(turned_away(&ray, tri), "case {case}: spawned {ray:?} not turned away by {tri:?}");
+                    }
+                }
+            }
+            // From just off the plane, either way, near the lifted corner
+            // (where the triangle lies furthest off the plane) half the time
+            let on = if case % 4 < 2 { on } else { c + (on - c) * 0.01 };
+            let size = on.abs().element_sum();
+            let margin = size * 4.0 * f32::EPSILON + plane.scale * 18.0 * f32::EPSILON;
+            let height = side * margin * 2f32.powf(uniform() * 12.0 - 8.0);
+            let direction = if uniform() < 0.5 { away } else { -away };
+            let ray = Ray::new(on + plane.normal * height, direction);
+            for tri in &run {
+                near += 1;
+                let turned = turned_away(&ray, tri);
+                if watertight(&ray, tri, f32::INFINITY).is_some() {
+                    hits += 1;
+                    assert!(!turned, "case {case}: a hit turned away by the cull of {tri:?}, ray {ray:?}");
+                } else if turned && direction.dot(plane.normal) * height > 0.0 {
+                    left += 1;
+                }
+            }
+        }
+        assert!(spawned > 5_000, "{spawned} spawned rays");
+        assert!(hits > 2_000 && left > 5_000, "{hits} hits and {left} rays leaving turned away of {near}");
+    }
+
     /// Triangles in one plane share it, with the run's scale; the edges of
     /// each are its own, and a triangle off the plane starts a run of its
     /// own.
