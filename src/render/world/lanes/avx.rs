@@ -254,7 +254,7 @@ unsafe fn power_half(z: __m128, k: __m128i, entry: __m128i, y: __m128) -> __m128
     let q = _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(c2), r), _mm256_set1_pd(1.0));
     let power = _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(p, r2), q), scale);
     let over = _mm256_cmp_pd::<_CMP_GT_OQ>(y_log2_x, _mm256_set1_pd(pow::OVERFLOW));
-    let under = _mm256_cmp_pd::<_CMP_LE_OQ>(y_log2_x, _mm256_set1_pd(pow::UNDERFLOW));
+    let under = _mm256_cmp_pd::<_CMP_LT_OQ>(y_log2_x, _mm256_set1_pd(pow::UNDERFLOW));
     let power = _mm256_blendv_pd(power, _mm256_set1_pd(f64::INFINITY), over);
     _mm256_cvtpd_ps(_mm256_blendv_pd(power, _mm256_setzero_pd(), under))
 }
