@@ -180,9 +180,11 @@ impl<R: Real> Crossing<R> {
 /// an origin of coordinates summing to `size`, can err (2 ulps of `size`
 /// and one of the scale): each bound doubled. No triangle of the plane lies
 /// ahead of them, so the watertight test could only miss. These are the
-/// rays leaving a triangle of the plane: spawned off it by far more
-/// (`offset_origin`, 128 ulps of the point), their crossing lies behind
-/// them by less than the slack, and the test turned none away.
+/// rays leaving a triangle of the plane: spawned off it by 128 ulps of the
+/// point or more (`offset_origin`), far more than the margin unless the
+/// point lies much nearer the origin than the plane's scale, their
+/// crossing lies behind them by less than the slack, and the test turned
+/// none away.
 #[inline(always)]
 fn leaving<R: Real>(t: R, rise: R, size: R, scale: R) -> R::Mask {
     let margin = size * (4.0 * f32::EPSILON) + scale * (18.0 * f32::EPSILON);
