@@ -332,6 +332,22 @@ mod tests {
         assert!(intersect_triangle(&Ray::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::Z), &tri, 1.0).is_none());
     }
 
+    /// Uniform numbers in [0, 1) from xorshift64, seeded.
+    fn uniform_stream(mut state: u64) -> impl FnMut() -> f32 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    /// The cull's verdict on `ray` and `tri`: (turned away, sure).
+    fn cull(ray: &Ray, tri: &Triangle) -> (bool, bool) {
+        let crossing = Crossing::<f32>::of(ray.origin.into(), ray.direction.into(), &tri.cull.plane);
+        crossing.test(&tri.cull.edges.splat(), f32::INFINITY)
+    }
+
     /// The cull in front of the watertight test never turns a hit into a
     /// miss: triangles at scales 1e-6 … 1e6, 100 of their sizes from the
     /// origin, seen from 1e-3 to 1e3 of their size away, rays aimed at
@@ -341,17 +357,7 @@ mod tests {
     /// hit (the crossing) lies within its error bound of the triangle.
     #[test]
     fn the_cull_never_turns_away_a_hit() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
-        let cull = |ray: &Ray, tri: &Triangle| {
-            let crossing = Crossing::<f32>::of(ray.origin.into(), ray.direction.into(), &tri.cull.plane);
-            crossing.test(&tri.cull.edges.splat(), f32::INFINITY)
-        };
+        let mut uniform = uniform_stream(0x2545_f491_4f6c_dd1d);
         let (mut hits, mut sure, mut away, mut away_turned, mut beside, mut beside_turned) = (0, 0, 0, 0, 0, 0);
         let mut worst = 0f64;
         for case in 0..40_000 {
@@ -431,17 +437,8 @@ mod tests {
     #[test]
     fn rays_leaving_a_plane_are_turned_away_and_never_a_hit() {
         use crate::geometry::offset_ray_origin;
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
-        let turned_away = |ray: &Ray, tri: &Triangle| {
-            let crossing = Crossing::<f32>::of(ray.origin.into(), ray.direction.into(), &tri.cull.plane);
-            crossing.test(&tri.cull.edges.splat(), f32::INFINITY).0
-        };
+        let mut uniform = uniform_stream(0x9e37_79b9_7f4a_7c15);
+        let turned_away = |ray: &Ray, tri: &Triangle| cull(ray, tri).0;
         let point =
             |uniform: &mut dyn FnMut() -> f32| Vec3::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5) * 2.0;
         let (mut spawned, mut near, mut hits, mut left) = (0, 0, 0, 0);
