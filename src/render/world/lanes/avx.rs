@@ -176,34 +176,37 @@ impl F8 {
             // A signalling NaN's x⁰ is NaN in libm
             let one = M8(_mm256_castsi256_ps(y_zero)).and(self.eq(self));
             let pending = !fast.or(one).or(zero_base);
-            // No lane on the fast path (a point light's x⁰ in every lane):
-            // its f64 evaluation of what the lanes hold cost mirror-caustic's
-            // path tracing a tenth of its time, all of it in subnormal
-            // assists (flush-to-zero recovered the same)
-            if !fast.any() && !pending.any() {
-                return one.select(F8::splat(1.0), F8::splat(0.0));
-            }
-            // log₂ x's table index, exponent and reduced mantissa (`pow::log2_of`)
-            let from_offset = _mm256_sub_epi32(x_bits, _mm256_set1_epi32(pow::LOG2_OFFSET as i32));
-            let entry =
-                _mm256_slli_epi32::<1>(_mm256_and_si256(_mm256_srli_epi32::<19>(from_offset), _mm256_set1_epi32(15)));
-            let top = _mm256_and_si256(from_offset, _mm256_set1_epi32(0xff80_0000u32 as i32));
-            let z = _mm256_castsi256_ps(_mm256_sub_epi32(x_bits, top));
-            let k = _mm256_srai_epi32::<23>(top);
-            let low = power_half(
-                _mm256_castps256_ps128(z),
-                _mm256_castsi256_si128(k),
-                _mm256_castsi256_si128(entry),
-                _mm256_castps256_ps128(exponent.0),
-            );
-            let high = power_half(
-                _mm256_extractf128_ps::<1>(z),
-                _mm256_extracti128_si256::<1>(k),
-                _mm256_extracti128_si256::<1>(entry),
-                _mm256_extractf128_ps::<1>(exponent.0),
-            );
-            let power = F8(_mm256_set_m128(high, low));
-            let power = fast.select(power, one.select(F8::splat(1.0), F8::splat(0.0)));
+            let settled = one.select(F8::splat(1.0), F8::splat(0.0));
+            // Only where a lane takes the fast path: the f64 evaluation of
+            // what the other lanes hold (a point light's x⁰ in every lane)
+            // cost mirror-caustic's path tracing a tenth of its time, all
+            // of it in subnormal assists (flush-to-zero recovered the same)
+            let power = if fast.any() {
+                // log₂ x's table index, exponent and reduced mantissa (`pow::log2_of`)
+                let from_offset = _mm256_sub_epi32(x_bits, _mm256_set1_epi32(pow::LOG2_OFFSET as i32));
+                let entry = _mm256_slli_epi32::<1>(_mm256_and_si256(
+                    _mm256_srli_epi32::<19>(from_offset),
+                    _mm256_set1_epi32(15),
+                ));
+                let top = _mm256_and_si256(from_offset, _mm256_set1_epi32(0xff80_0000u32 as i32));
+                let z = _mm256_castsi256_ps(_mm256_sub_epi32(x_bits, top));
+                let k = _mm256_srai_epi32::<23>(top);
+                let low = power_half(
+                    _mm256_castps256_ps128(z),
+                    _mm256_castsi256_si128(k),
+                    _mm256_castsi256_si128(entry),
+                    _mm256_castps256_ps128(exponent.0),
+                );
+                let high = power_half(
+                    _mm256_extractf128_ps::<1>(z),
+                    _mm256_extracti128_si256::<1>(k),
+                    _mm256_extracti128_si256::<1>(entry),
+                    _mm256_extractf128_ps::<1>(exponent.0),
+                );
+                fast.select(F8(_mm256_set_m128(high, low)), settled)
+            } else {
+                settled
+            };
             if !pending.any() {
                 return power;
             }
