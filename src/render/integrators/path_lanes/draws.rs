@@ -78,7 +78,7 @@ impl PathLanes {
         given: &mut [Option<Given>; LANES],
     ) {
         let wanted = hits.found.and(M8::from_fn(|i| wants[i].is_some()));
-        let surfaces = LaneSurfaces::new(&self.surfaces, &hits.shape, wanted);
+        let surfaces = LaneSurfaces::new(&self.surfaces, hits.shape, wanted);
         let drawing = surfaces.lambert.or(surfaces.glossy.mask());
         if !drawing.any() {
             given.iter_mut().for_each(|g| *g = None);
@@ -126,7 +126,7 @@ impl PathLanes {
         let scattering = asking(|want| want.scatter);
         let surfaces = match scattering.bits() == drawing.bits() {
             true => surfaces,
-            false => LaneSurfaces::new(&self.surfaces, &hits.shape, scattering),
+            false => LaneSurfaces::new(&self.surfaces, hits.shape, scattering),
         };
         let wo = -direction;
         let facing = normal.dot(wo).lt(F8::splat(0.0)).select_v(-normal, normal);

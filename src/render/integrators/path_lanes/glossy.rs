@@ -4,10 +4,11 @@
 
 use glam::Vec3;
 
-use super::{Surface, BLINN_PHONG, PHONG};
+use super::scatter::SurfaceTable;
+use super::{BLINN_PHONG, PHONG};
 use crate::geometry::{frame_from_z, to_world};
 use crate::render::world::bsdf::{blinn_phong_of, phong_of, reflect_of};
-use crate::render::world::lanes::{F8, LANES, M8, V8};
+use crate::render::world::lanes::{Index8, F8, M8, V8};
 use crate::render::world::sampling::{cosine_hemisphere_of, power_cosine_of};
 
 /// The glossy lanes of a bounce and their surfaces' lobes.
@@ -25,7 +26,7 @@ impl GlossyLanes {
     /// The lanes of `alive` on a Phong or Blinn–Phong surface; `color` is
     /// each lane's surface colour (the diffuse lobe's).
     #[inline(always)]
-    pub(super) fn new(surface: &[&Surface; LANES], code: F8, color: V8, alive: M8) -> Self {
+    pub(super) fn new(table: &SurfaceTable, index: Index8, code: F8, color: V8, alive: M8) -> Self {
         let phong = code.eq(F8::splat(PHONG)).and(alive);
         let blinn_phong = code.eq(F8::splat(BLINN_PHONG)).and(alive);
         // The lobes' parameters gathered only where a lane is glossy: every
@@ -33,10 +34,10 @@ impl GlossyLanes {
         // nothing (2.7% of smallpt's instructions)
         let (ks, exponent, diffuse_probability, normalisation) = match phong.or(blinn_phong).any() {
             true => (
-                V8::from_fn(|i| surface[i].specular),
-                F8::from_fn(|i| surface[i].exponent),
-                F8::from_fn(|i| surface[i].diffuse_probability),
-                F8::from_fn(|i| surface[i].normalisation),
+                table.specular.get(index),
+                table.exponent.get(index),
+                table.diffuse_probability.get(index),
+                table.normalisation.get(index),
             ),
             false => (V8::splat(Vec3::ZERO), F8::splat(0.0), F8::splat(0.0), F8::splat(0.0)),
         };

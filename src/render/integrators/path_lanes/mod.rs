@@ -25,6 +25,7 @@ pub(crate) use draws::{Given, PickedLight, Want};
 pub(crate) use lights::EmittedLanes;
 use lights::{LaneLights, LightLanes};
 use samples::{CameraSample, CameraSamples};
+use scatter::SurfaceTable;
 pub(crate) use scatter::{LaneSurfaces, Scattered};
 
 use super::Counters;
@@ -35,7 +36,7 @@ use crate::geometry::{gamma, intersect_triangle, offset_origin, Ray, SurfaceHit,
 use crate::geometry::{plane_exit_of, plane_point_of, plane_t_of, Crossing, CullEdges, CullPlane};
 use crate::render::world::bsdf::{blinn_normalisation, Bsdf, Transport};
 use crate::render::world::camera::CameraTile;
-use crate::render::world::lanes::{self, Count8, Rng8, F8, LANES, M8, V8};
+use crate::render::world::lanes::{self, Column, Column3, Count8, Index8, Rng8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSource};
 use crate::render::world::occluders::Shadow;
 use crate::render::world::sampling::{power_heuristic, power_heuristic_of, uniform_sphere_pdf};
@@ -86,6 +87,31 @@ struct SphereInfo {
     wall_slack: f32,
 }
 
+/// What a sphere's hit is rebuilt from, a column per field, indexed by
+/// shape (`PathLanes::sphere_hits`).
+#[derive(Clone, Debug)]
+struct SphereColumns {
+    center: Column3,
+    radius: Column,
+    /// 1 for a wall, 0 for any other sphere.
+    wall: Column,
+    error: Column,
+    wall_slack: Column,
+}
+
+impl SphereColumns {
+    fn new(spheres: &[SphereInfo]) -> Self {
+        let column = |field: fn(&SphereInfo) -> f32| Column::new(spheres.iter().map(field));
+        SphereColumns {
+            center: Column3::new(spheres.iter().map(|s| s.center)),
+            radius: column(|s| s.radius),
+            wall: column(|s| s.wall.map_or(0.0, |_| 1.0)),
+            error: column(|s| s.error),
+            wall_slack: column(|s| s.wall_slack),
+        }
+    }
+}
+
 /// One plane, as the hit loop and shadow rays meet it.
 #[derive(Clone, Copy, Debug)]
 struct PlaneInfo {
@@ -111,7 +137,7 @@ pub(crate) struct LaneHits {
     pub(crate) found: M8,
     t: F8,
     /// Spheres, then planes, then triangles: an index into `surfaces`.
-    shape: [i32; LANES],
+    shape: Index8,
     pub(crate) point: V8,
     /// The geometric normal.
     pub(crate) normal: V8,
@@ -122,7 +148,12 @@ pub(crate) struct LaneHits {
 #[derive(Clone, Debug)]
 pub struct PathLanes {
     spheres: Vec<SphereInfo>,
+    sphere_columns: SphereColumns,
     planes: Vec<PlaneInfo>,
+    /// The planes' normals and offsets, indexed by shape (zeros before
+    /// the first plane).
+    plane_normals: Column3,
+    plane_offsets: Column,
     triangles: Vec<Triangle>,
     /// What the cull reads of each triangle, in one record (read from the
     /// triangle and a list of runs beside it, its loads and bounds checks
@@ -132,7 +163,7 @@ pub struct PathLanes {
     /// toward a light on a triangle skips the triangles of its plane.
     triangle_planes: Vec<u32>,
     /// Spheres, then planes, then triangles: what shading needs of each.
-    surfaces: Vec<Surface>,
+    surfaces: SurfaceTable,
     /// Shadow rays test these always, and the walls only for paths not
     /// inside every wall (see `occluders::Walls`).
     others: Vec<Occluder>,
@@ -203,7 +234,7 @@ impl PathLanes {
                 }
             })
             .collect();
-        let planes = (world.planes.iter())
+        let planes: Vec<PlaneInfo> = (world.planes.iter())
             .map(|plane| PlaneInfo {
                 normal: plane.normal,
                 offset: plane.offset,
@@ -236,15 +267,20 @@ impl PathLanes {
             emitter: light_spheres.contains(&Some(i as u32)).then_some(i as u32),
         };
         let (walls, others) = (0..spheres.len()).partition::<Vec<_>, _>(|&i| spheres[i].wall.is_some());
+        let before_planes = std::iter::repeat_n(None, spheres.len());
+        let by_shape = || before_planes.clone().chain(planes.iter().map(Some));
         Some(PathLanes {
             others: others.into_iter().map(occluder).collect(),
             walls: walls.into_iter().map(occluder).collect(),
+            sphere_columns: SphereColumns::new(&spheres),
             spheres,
+            plane_normals: Column3::new(by_shape().map(|p| p.map_or(Vec3::ZERO, |p| p.normal))),
+            plane_offsets: Column::new(by_shape().map(|p| p.map_or(0.0, |p| p.offset))),
             planes,
             triangles: world.triangles.iter().map(|(triangle, _)| *triangle).collect(),
             triangle_culls: lane_culls(&world.triangles),
             triangle_planes: world.light_plane.clone(),
-            surfaces,
+            surfaces: SurfaceTable::new(surfaces),
             lights: LaneLights::new(world),
             light_spheres,
             light_planes,
@@ -279,13 +315,14 @@ impl PathLanes {
     pub(crate) fn hits_of(&self, world: &World, hits: &LaneHits) -> [Option<Hit>; LANES] {
         // Out of the registers first: the closure below does not inherit AVX2
         let found = hits.found.bits();
+        let shape = hits.shape.to_array();
         let t = hits.t.to_array();
         let error = hits.error.to_array();
         let point = [hits.point.x.to_array(), hits.point.y.to_array(), hits.point.z.to_array()];
         let normal = [hits.normal.x.to_array(), hits.normal.y.to_array(), hits.normal.z.to_array()];
         lanes::each(|i| {
             (found & 1 << i != 0).then(|| {
-                let object = self.surfaces[hits.shape[i] as usize].object;
+                let object = self.surfaces.records[shape[i] as usize].object;
                 let surface = SurfaceHit {
                     t: t[i],
                     point: Vec3::new(point[0][i], point[1][i], point[2][i]),
@@ -303,7 +340,7 @@ impl PathLanes {
     #[inline(always)]
     pub(crate) fn hit_surfaces(&self, active: M8, held: M8, origin: V8, direction: V8) -> (LaneHits, LaneSurfaces<'_>) {
         let hits = self.nearest(active, held, origin, direction);
-        let surfaces = LaneSurfaces::new(&self.surfaces, &hits.shape, hits.found);
+        let surfaces = LaneSurfaces::new(&self.surfaces, hits.shape, hits.found);
         (hits, surfaces)
     }
 
@@ -418,8 +455,8 @@ impl PathLanes {
         if !alive.any() {
             return missed;
         }
-        let surfaces = LaneSurfaces::new(&self.surfaces, &shape, alive);
-        let LaneSurfaces { surface, emissive, ref glossy, color, .. } = surfaces;
+        let surfaces = LaneSurfaces::new(&self.surfaces, shape, alive);
+        let LaneSurfaces { emissive, ref glossy, color, .. } = surfaces;
         // What next-event estimation shades
         let diffuse = surfaces.lambert.or(glossy.mask());
         let wo = -direction;
@@ -432,8 +469,10 @@ impl PathLanes {
 
         // Emission reached by this ray, weighted against light sampling (rare: lane by lane)
         let glowing = emissive.and(normal.dot(wo).gt(F8::splat(0.0))).and(color.nonzero());
+        let shapes = if glowing.any() { shape.to_array() } else { [0; LANES] };
         for lane in glowing.lanes() {
-            let object = surface[lane].object;
+            let surface = &self.surfaces.records[shapes[lane] as usize];
+            let object = surface.object;
             let weight = match world.objects[object as usize].light {
                 Some(light) if !st.after_delta.test(lane) => power_heuristic(
                     st.last_pdf.lane(lane),
@@ -441,7 +480,7 @@ impl PathLanes {
                 ),
                 _ => 1.0,
             };
-            let sum = st.radiance.lane(lane) + st.throughput.lane(lane) * surface[lane].color * weight;
+            let sum = st.radiance.lane(lane) + st.throughput.lane(lane) * surface.color * weight;
             st.radiance.set_lane(lane, sum);
         }
 
@@ -629,20 +668,17 @@ impl PathLanes {
             }
         }
         let found = active.and(t_hit.lt(F8::splat(f32::INFINITY)));
-        let shape = index.truncate();
+        let shape = index.to_index();
         let on_sphere = found.and(index.lt(F8::splat(first_plane)));
         let on_plane = found.and_not(on_sphere).and(index.lt(F8::splat(first_triangle)));
 
         let (mut point, mut normal, mut error) = (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
         if on_sphere.any() {
-            self.sphere_hits(on_sphere, held, &shape, origin, direction, t_hit, &mut point, &mut normal, &mut error);
+            self.sphere_hits(on_sphere, held, shape, origin, direction, t_hit, &mut point, &mut normal, &mut error);
         }
         if on_plane.any() {
-            let last = self.planes.len() - 1;
-            let plane: [&PlaneInfo; LANES] =
-                lanes::each(|i| &self.planes[(shape[i] as usize).saturating_sub(self.spheres.len()).min(last)]);
-            let plane_normal = V8::from_fn(|i| plane[i].normal);
-            let offset = F8::from_fn(|i| plane[i].offset);
+            let plane_normal = self.plane_normals.get(shape);
+            let offset = self.plane_offsets.get(shape);
             let (p, e) = plane_point_of(origin, direction, plane_normal, offset, t_hit);
             point = on_plane.select_v(p, point);
             normal = on_plane.select_v(plane_normal, normal);
@@ -666,7 +702,7 @@ impl PathLanes {
         &self,
         on_sphere: M8,
         held: M8,
-        shape: &[i32; LANES],
+        shape: Index8,
         origin: V8,
         direction: V8,
         t_hit: F8,
@@ -674,11 +710,10 @@ impl PathLanes {
         normal: &mut V8,
         error: &mut F8,
     ) {
-        let last = self.spheres.len() - 1;
-        let sphere: [&SphereInfo; LANES] = lanes::each(|i| &self.spheres[(shape[i] as usize).min(last)]);
-        let center = V8::from_fn(|i| sphere[i].center);
-        let radius = F8::from_fn(|i| sphere[i].radius);
-        let leaving = held.and(M8::from_fn(|i| sphere[i].wall.is_some())).and(on_sphere);
+        let columns = &self.sphere_columns;
+        let center = columns.center.get(shape);
+        let radius = columns.radius.get(shape);
+        let leaving = held.and(columns.wall.get(shape).ne(F8::splat(0.0))).and(on_sphere);
         if on_sphere.and_not(leaving).any() {
             let f = origin - center;
             // Which root `roots` took (solved again: cheaper than tracking
@@ -692,10 +727,10 @@ impl PathLanes {
             let n = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
             *point = on_sphere.select_v(center + n * radius, *point);
             *normal = on_sphere.select_v(n, *normal);
-            *error = on_sphere.select(F8::from_fn(|i| sphere[i].error), *error);
+            *error = on_sphere.select(columns.error.get(shape), *error);
         }
         if leaving.any() {
-            let slack = F8::from_fn(|i| sphere[i].wall_slack);
+            let slack = columns.wall_slack.get(shape);
             let (p, n, e) = wall_exit_hit(origin, direction, t_hit, center, slack);
             *point = leaving.select_v(p, *point);
             *normal = leaving.select_v(n, *normal);

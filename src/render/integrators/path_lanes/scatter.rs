@@ -5,16 +5,51 @@
 
 use std::f32::consts::FRAC_1_PI;
 
+use glam::Vec3;
+
 use super::glossy::GlossyLanes;
 use super::{Surface, EMITTER, GLASS, LAMBERT, MIRROR};
 use crate::geometry::{frame_from_z, to_world};
 use crate::render::world::bsdf::{reflect_of, refraction_of, Refraction, Transport};
-use crate::render::world::lanes::{self, Rng8, F8, LANES, M8, V8};
+use crate::render::world::lanes::{Column, Column3, Index8, Rng8, F8, M8, V8};
 use crate::render::world::sampling::cosine_hemisphere_of;
+
+/// Every shape's surface (spheres, then planes, then triangles): the
+/// records, and a column per field for the lanes to read eight at a time.
+#[derive(Clone, Debug)]
+pub(super) struct SurfaceTable {
+    pub(super) records: Vec<Surface>,
+    kind: Column,
+    color: Column3,
+    ior: Column,
+    pub(super) specular: Column3,
+    pub(super) exponent: Column,
+    pub(super) diffuse_probability: Column,
+    pub(super) normalisation: Column,
+}
+
+impl SurfaceTable {
+    pub(super) fn new(records: Vec<Surface>) -> Self {
+        let column = |field: fn(&Surface) -> f32| Column::new(records.iter().map(field));
+        let column3 = |field: fn(&Surface) -> Vec3| Column3::new(records.iter().map(field));
+        SurfaceTable {
+            kind: column(|s| s.kind),
+            color: column3(|s| s.color),
+            ior: column(|s| s.ior),
+            specular: column3(|s| s.specular),
+            exponent: column(|s| s.exponent),
+            diffuse_probability: column(|s| s.diffuse_probability),
+            normalisation: column(|s| s.normalisation),
+            records,
+        }
+    }
+}
 
 /// The surfaces of the lanes of `alive`, by material.
 pub(crate) struct LaneSurfaces<'a> {
-    pub(super) surface: [&'a Surface; LANES],
+    table: &'a SurfaceTable,
+    /// Each lane's shape.
+    index: Index8,
     pub(crate) lambert: M8,
     pub(crate) mirror: M8,
     pub(crate) glass: M8,
@@ -38,21 +73,22 @@ pub(crate) struct Scattered {
 }
 
 impl<'a> LaneSurfaces<'a> {
-    /// `shape` indexes `surfaces` (lanes outside `alive` read any).
+    /// `index` names each lane's shape in `table` (lanes outside `alive`
+    /// read any).
     #[inline(always)]
-    pub(super) fn new(surfaces: &'a [Surface], shape: &[i32; LANES], alive: M8) -> Self {
-        let surface: [&Surface; LANES] = lanes::each(|i| &surfaces[shape[i] as usize]);
-        let code = F8::from_fn(|i| surface[i].kind);
+    pub(super) fn new(table: &'a SurfaceTable, index: Index8, alive: M8) -> Self {
+        let code = table.kind.get(index);
         let kind = |k: f32| code.eq(F8::splat(k)).and(alive);
-        let color = V8::from_fn(|i| surface[i].color);
+        let color = table.color.get(index);
         LaneSurfaces {
             lambert: kind(LAMBERT),
             mirror: kind(MIRROR),
             glass: kind(GLASS),
             emissive: kind(EMITTER),
-            glossy: GlossyLanes::new(&surface, code, color, alive),
+            glossy: GlossyLanes::new(table, index, code, color, alive),
             color,
-            surface,
+            table,
+            index,
         }
     }
 
@@ -92,7 +128,7 @@ impl<'a> LaneSurfaces<'a> {
             go = go.or(ok);
         }
         if self.glass.any() {
-            let ior = F8::from_fn(|i| self.surface[i].ior);
+            let ior = self.table.ior.get(self.index);
             let entering = wo.dot(normal).gt(zero);
             let eta_i = entering.select(F8::splat(1.0), ior);
             let eta_t = entering.select(ior, F8::splat(1.0));

@@ -31,6 +31,11 @@ pub struct M8(__m256);
 #[repr(transparent)]
 pub struct Count8(__m256i);
 
+/// Eight indices into a `Column`.
+#[derive(Clone, Copy)]
+#[repr(transparent)]
+pub struct Index8(__m256i);
+
 // SAFETY (every `unsafe` below): AVX2 is present (the module's invariant);
 // the stores write whole local arrays.
 
@@ -151,6 +156,39 @@ impl F8 {
         let mut out = [0; LANES];
         unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), _mm256_cvttps_epi32(self.0)) };
         out
+    }
+
+    /// `truncate`, kept in a register to index `Column`s with.
+    #[inline(always)]
+    pub fn to_index(self) -> Index8 {
+        Index8(unsafe { _mm256_cvttps_epi32(self.0) })
+    }
+
+    /// `table[index]` lane by lane for indices in 0..16, `low` holding the
+    /// table's first eight values and `high` the rest: two permutes and a
+    /// blend (other indices give one of the sixteen).
+    #[inline(always)]
+    pub fn permuted(low: F8, high: F8, index: Index8) -> F8 {
+        F8(unsafe {
+            let from_low = _mm256_permutevar8x32_ps(low.0, index.0);
+            let from_high = _mm256_permutevar8x32_ps(high.0, index.0);
+            let in_high = _mm256_cmpgt_epi32(index.0, _mm256_set1_epi32(7));
+            _mm256_blendv_ps(from_low, from_high, _mm256_castsi256_ps(in_high))
+        })
+    }
+
+    /// `values[index]` lane by lane, an index beyond the last (or
+    /// negative) reading the last: one hardware gather.
+    #[inline(always)]
+    pub fn gathered(values: &[f32], index: Index8) -> F8 {
+        let Some(last) = values.len().checked_sub(1) else { return F8::splat(0.0) };
+        let last = last.min(i32::MAX as usize) as i32;
+        // SAFETY: as unsigned, a negative index exceeds `last`, so every
+        // lane reads within `values`
+        F8(unsafe {
+            let clamped = _mm256_min_epu32(index.0, _mm256_set1_epi32(last));
+            _mm256_i32gather_ps::<4>(values.as_ptr(), clamped)
+        })
     }
 
     /// `pow::powf` lane by lane, four lanes at a time in f64 with its
@@ -422,6 +460,21 @@ impl Count8 {
     #[inline(always)]
     pub fn reset(self, mask: M8) -> Count8 {
         Count8(unsafe { _mm256_andnot_si256(_mm256_castps_si256(mask.0), self.0) })
+    }
+}
+
+impl Index8 {
+    #[inline(always)]
+    pub fn to_array(self) -> [i32; LANES] {
+        let mut out = [0; LANES];
+        unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), self.0) };
+        out
+    }
+}
+
+impl fmt::Debug for Index8 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Index8({:?})", self.to_array())
     }
 }
 

@@ -35,15 +35,17 @@ pub fn supported() -> bool {
 
 #[cfg(target_arch = "x86_64")]
 mod avx;
+mod column;
 // On x86-64 only the tests build these, to hold the intrinsics to them
 #[cfg(any(test, not(target_arch = "x86_64")))]
 #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
 mod portable;
 
 #[cfg(target_arch = "x86_64")]
-pub use avx::{Count8, F8, M8};
+pub use avx::{Count8, Index8, F8, M8};
+pub use column::{Column, Column3};
 #[cfg(not(target_arch = "x86_64"))]
-pub use portable::{Count8, F8, M8};
+pub use portable::{Count8, Index8, F8, M8};
 
 // What both kinds of lanes share, written once over their primitives
 
@@ -463,6 +465,16 @@ mod tests {
             let whole = fa.min(F8::splat(2e9)).max(F8::splat(-2e9));
             let p_whole = pa.min(p::F8::splat(2e9)).max(p::F8::splat(-2e9));
             assert_eq!(whole.truncate(), p_whole.truncate(), "truncate {a:?}");
+            // Indices of every sign and size read the same members: from
+            // sixteen by permutes, from the whole list by a gather
+            let (index, p_index) = (whole.to_index(), p_whole.to_index());
+            assert_eq!(index.to_array(), p_index.to_array());
+            same(F8::permuted(fa, fb, index), p::F8::permuted(pa, pb, p_index), "permuted");
+            let small = F8::from_fn(|i| (a[i].to_bits() % 24) as f32 - 2.0).to_index();
+            let p_small = p::F8::from_array(std::array::from_fn(|i| (a[i].to_bits() % 24) as f32 - 2.0)).to_index();
+            same(F8::permuted(fa, fb, small), p::F8::permuted(pa, pb, p_small), "permuted");
+            same(F8::gathered(&values, small), p::F8::gathered(&values, p_small), "gathered");
+            same(F8::gathered(&values, index), p::F8::gathered(&values, p_index), "gathered");
             let masks = [
                 (fa.lt(fb), pa.lt(pb)),
                 (fa.le(fb), pa.le(pb)),

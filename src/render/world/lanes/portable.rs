@@ -21,6 +21,11 @@ pub struct M8([i32; LANES]);
 #[repr(C, align(32))]
 pub struct Count8([u32; LANES]);
 
+/// Eight indices into a `Column`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(32))]
+pub struct Index8([i32; LANES]);
+
 impl F8 {
     #[inline(always)]
     pub fn splat(v: f32) -> Self {
@@ -130,6 +135,32 @@ impl F8 {
         self.0.map(|v| v as i32)
     }
 
+    /// `truncate`, kept to index `Column`s with.
+    #[inline(always)]
+    pub fn to_index(self) -> Index8 {
+        Index8(self.truncate())
+    }
+
+    /// `table[index]` lane by lane for indices in 0..16, `low` holding the
+    /// table's first eight values and `high` the rest (other indices read
+    /// as the AVX2 permutes read them).
+    #[inline(always)]
+    pub fn permuted(low: F8, high: F8, index: Index8) -> F8 {
+        F8(from_fn(|i| {
+            let k = index.0[i];
+            let table = if k > 7 { high } else { low };
+            table.0[(k & 7) as usize]
+        }))
+    }
+
+    /// `values[index]` lane by lane, an index beyond the last (or
+    /// negative) reading the last.
+    #[inline(always)]
+    pub fn gathered(values: &[f32], index: Index8) -> F8 {
+        let Some(&last) = values.last() else { return F8::splat(0.0) };
+        F8(from_fn(|i| usize::try_from(index.0[i]).ok().and_then(|k| values.get(k)).copied().unwrap_or(last)))
+    }
+
     #[inline(always)]
     pub fn powf(self, exponent: F8) -> Self {
         self.zip(exponent, pow::powf)
@@ -226,6 +257,13 @@ impl Not for M8 {
     #[inline(always)]
     fn not(self) -> M8 {
         M8(from_fn(|i| !self.0[i]))
+    }
+}
+
+impl Index8 {
+    #[inline(always)]
+    pub fn to_array(self) -> [i32; LANES] {
+        self.0
     }
 }
 
