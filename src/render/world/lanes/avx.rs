@@ -349,6 +349,22 @@ impl M8 {
     pub const NONE: M8 = M8(unsafe { std::mem::transmute::<[i32; LANES], __m256>([0; LANES]) });
     pub const ALL: M8 = M8(unsafe { std::mem::transmute::<[i32; LANES], __m256>([-1; LANES]) });
 
+    /// Only lane `lane` (none for a lane past the last).
+    #[inline(always)]
+    pub fn only(lane: usize) -> Self {
+        let lane = lane.min(LANES) as i32;
+        M8(unsafe {
+            let index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+            _mm256_castsi256_ps(_mm256_cmpeq_epi32(index, _mm256_set1_epi32(lane)))
+        })
+    }
+
+    /// Every lane `value`.
+    #[inline(always)]
+    pub fn splat(value: bool) -> Self {
+        M8(unsafe { _mm256_castsi256_ps(_mm256_set1_epi32(-(value as i32))) })
+    }
+
     #[inline(always)]
     pub fn from_fn(mut f: impl FnMut(usize) -> bool) -> Self {
         let v: [i32; LANES] = crate::render::world::lanes::each(|i| -(f(i) as i32));

@@ -275,6 +275,13 @@ impl Rng8 {
         self.state
     }
 
+    /// The lanes of `mask` take up the stream at `state`.
+    #[inline(always)]
+    pub fn start(&mut self, mask: M8, state: u64) {
+        let mask = mask.to_array();
+        self.state = each(|i| if mask[i] != 0 { state } else { self.state[i] });
+    }
+
     /// `Sampler::next_f32` in the lanes of `mask` (others: unchanged, value unused).
     #[inline(always)]
     pub fn next_f32(&mut self, mask: M8) -> F8 {

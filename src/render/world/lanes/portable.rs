@@ -201,6 +201,18 @@ impl M8 {
     pub const NONE: M8 = M8([0; LANES]);
     pub const ALL: M8 = M8([-1; LANES]);
 
+    /// Only lane `lane` (none for a lane past the last).
+    #[inline(always)]
+    pub fn only(lane: usize) -> Self {
+        M8(from_fn(|i| -((i == lane) as i32)))
+    }
+
+    /// Every lane `value`.
+    #[inline(always)]
+    pub fn splat(value: bool) -> Self {
+        M8([-(value as i32); LANES])
+    }
+
     #[inline(always)]
     pub fn from_fn(mut f: impl FnMut(usize) -> bool) -> Self {
         M8(from_fn(|i| -(f(i) as i32)))
