@@ -36,17 +36,21 @@ pub struct MergeGrid {
     points: PointGrid,
     /// By slot in the grid's order.
     vertices: Vec<MergeVertex>,
-    /// The records in the vertices' order, kept for the next pass.
-    spare: Vec<MergeVertex>,
+    /// The records and positions in the vertices' order, kept for the
+    /// next pass.
+    spare: (Vec<MergeVertex>, Vec<Vec3>),
 }
 
-/// A grid's two record arrays, kept from pass to pass: above 32 MiB
-/// (VCM at 512×384) each was mapped afresh every pass and its pages
-/// faulted in again (`engine::heap`).
+/// A grid's arrays, kept from pass to pass: above 32 MiB (VCM at
+/// 512×384) each was mapped afresh every pass and its pages faulted in
+/// again (`engine::heap`); and what a pass leaves in them is written over,
+/// never cleared first (cleared and refilled with defaults, the records
+/// were a fifth of the grid's time on gap-room).
 #[derive(Default)]
 pub struct MergeBuffers {
     by_vertex: Vec<MergeVertex>,
     by_slot: Vec<MergeVertex>,
+    positions: Vec<Vec3>,
 }
 
 impl MergeGrid {
@@ -56,10 +60,12 @@ impl MergeGrid {
         // The vertices read in sequence here, so that only small records
         // are gathered in the grid's order; each chunk into its own stretch
         let count = paths.chunks.iter().map(|chunk| chunk.vertices.len()).sum();
-        let MergeBuffers { by_vertex: mut merged, by_slot: mut vertices } = buffers;
-        merged.clear();
+        let MergeBuffers { by_vertex: mut merged, by_slot: mut vertices, mut positions } = buffers;
+        // Every entry below `count` is written below
+        merged.truncate(count);
         merged.resize(count, MergeVertex::default());
-        let mut positions = vec![Vec3::ZERO; count];
+        positions.truncate(count);
+        positions.resize(count, Vec3::ZERO);
         let mut stretches = Vec::with_capacity(paths.chunks.len());
         let (mut positions_left, mut merged_left) = (&mut positions[..], &mut merged[..]);
         for chunk in &paths.chunks {
@@ -82,12 +88,13 @@ impl MergeGrid {
         });
         let points = PointGrid::build(&positions, |&p| p, radius * MERGE_CELLS);
         points.in_grid_order_into(&merged, &mut vertices);
-        Self { points, vertices, spare: merged }
+        Self { points, vertices, spare: (merged, positions) }
     }
 
-    /// Its record arrays, for the next pass's grid.
+    /// Its arrays, for the next pass's grid.
     pub fn into_buffers(self) -> MergeBuffers {
-        MergeBuffers { by_vertex: self.spare, by_slot: self.vertices }
+        let (by_vertex, positions) = self.spare;
+        MergeBuffers { by_vertex, by_slot: self.vertices, positions }
     }
 
     /// Every light vertex within `radius` of `point` (squared distance ≤
