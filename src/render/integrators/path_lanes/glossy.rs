@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::scatter::SurfaceTable;
+use super::surface_table::SurfaceTable;
 use super::{BLINN_PHONG, PHONG};
 use crate::geometry::{frame_from_z, to_world};
 use crate::render::world::bsdf::{blinn_phong_of, phong_of, reflect_of};

@@ -20,13 +20,14 @@ mod glossy;
 mod lights;
 mod samples;
 mod scatter;
+mod surface_table;
 
 pub(crate) use draws::{Given, PickedLight, Want};
 pub(crate) use lights::EmittedLanes;
 use lights::{LaneLights, LightLanes};
 use samples::CameraSamples;
-use scatter::SurfaceTable;
 pub(crate) use scatter::{LaneSurfaces, Scattered};
+use surface_table::SurfaceTable;
 
 use super::Counters;
 use crate::faults::{self, Fault};

@@ -5,45 +5,13 @@
 
 use std::f32::consts::FRAC_1_PI;
 
-use glam::Vec3;
-
 use super::glossy::GlossyLanes;
-use super::{Surface, EMITTER, GLASS, LAMBERT, MIRROR};
+use super::surface_table::SurfaceTable;
+use super::{EMITTER, GLASS, LAMBERT, MIRROR};
 use crate::geometry::{frame_from_z, to_world};
 use crate::render::world::bsdf::{reflect_of, refraction_of, Refraction, Transport};
-use crate::render::world::lanes::{Column, Column3, Index8, Rng8, F8, M8, V8};
+use crate::render::world::lanes::{Index8, Rng8, F8, M8, V8};
 use crate::render::world::sampling::cosine_hemisphere_of;
-
-/// Every shape's surface (spheres, then planes, then triangles): the
-/// records, and a column per field for the lanes to read eight at a time.
-#[derive(Clone, Debug)]
-pub(super) struct SurfaceTable {
-    pub(super) records: Vec<Surface>,
-    kind: Column,
-    color: Column3,
-    ior: Column,
-    pub(super) specular: Column3,
-    pub(super) exponent: Column,
-    pub(super) diffuse_probability: Column,
-    pub(super) normalisation: Column,
-}
-
-impl SurfaceTable {
-    pub(super) fn new(records: Vec<Surface>) -> Self {
-        let column = |field: fn(&Surface) -> f32| Column::new(records.iter().map(field));
-        let column3 = |field: fn(&Surface) -> Vec3| Column3::new(records.iter().map(field));
-        SurfaceTable {
-            kind: column(|s| s.kind),
-            color: column3(|s| s.color),
-            ior: column(|s| s.ior),
-            specular: column3(|s| s.specular),
-            exponent: column(|s| s.exponent),
-            diffuse_probability: column(|s| s.diffuse_probability),
-            normalisation: column(|s| s.normalisation),
-            records,
-        }
-    }
-}
 
 /// The surfaces of the lanes of `alive`, by material.
 pub(crate) struct LaneSurfaces<'a> {
