@@ -31,7 +31,7 @@ use surface_table::SurfaceTable;
 
 use super::Counters;
 use crate::faults::{self, Fault};
-use crate::geometry::sphere::{nearest_root, roots, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
+use crate::geometry::sphere::{nearest_root, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_finish_of, watertight_range_of, RayShear};
 use crate::geometry::{gamma, intersect_triangle, offset_origin, Ray, SurfaceHit, Triangle};
 use crate::geometry::{plane_exit_of, plane_point_of, plane_t_of, Crossing, CullEdges, CullPlane};
@@ -577,6 +577,9 @@ impl PathLanes {
         let mut t_hit = F8::splat(f32::INFINITY);
         // The index in a float lane, counted there too: one blend per sphere
         let mut index = F8::splat(0.0);
+        // Of the sphere hit so far: whether by its near root, and the
+        // discriminant (`sphere_hits` rebuilds the point from them)
+        let (mut sphere_near, mut sphere_discriminant) = (M8::NONE, F8::splat(0.0));
         let mut k = F8::splat(0.0);
         for sphere in &self.spheres {
             if sphere.wall.is_none() || !every_held {
@@ -588,10 +591,12 @@ impl PathLanes {
                     k = k + 1.0;
                     continue;
                 }
-                let (t, closer, _) = nearest_root(f, direction, F8::splat(sphere.radius2), t_hit);
+                let (t, closer, near) = nearest_root(f, direction, F8::splat(sphere.radius2), t_hit);
                 let closer = if sphere.wall.is_some() { closer.and_not(held) } else { closer };
                 t_hit = closer.select(t, t_hit);
                 index = closer.select(k, index);
+                sphere_near = closer.select_mask(near, sphere_near);
+                sphere_discriminant = closer.select(discriminant, sphere_discriminant);
             }
             k = k + 1.0;
         }
@@ -675,7 +680,19 @@ impl PathLanes {
 
         let (mut point, mut normal, mut error) = (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
         if on_sphere.any() {
-            self.sphere_hits(on_sphere, held, shape, origin, direction, t_hit, &mut point, &mut normal, &mut error);
+            let roots = (sphere_near, sphere_discriminant);
+            self.sphere_hits(
+                on_sphere,
+                held,
+                shape,
+                roots,
+                origin,
+                direction,
+                t_hit,
+                &mut point,
+                &mut normal,
+                &mut error,
+            );
         }
         if on_plane.any() {
             let plane_normal = self.plane_normals.get(shape);
@@ -695,8 +712,9 @@ impl PathLanes {
     }
 
     /// The hits of lanes `on_sphere` (`shape` their sphere's index), rebuilt
-    /// from the closest approach as `sphere_hit` does; a wall holding the
-    /// path is left where `wall_exit` found it.
+    /// from the closest approach as `sphere_hit` does, given whether the
+    /// search took the near root and the discriminant (`roots`); a wall
+    /// holding the path is left where `wall_exit` found it.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn sphere_hits(
@@ -704,6 +722,7 @@ impl PathLanes {
         on_sphere: M8,
         held: M8,
         shape: Index8,
+        (near, discriminant): (M8, F8),
         origin: V8,
         direction: V8,
         t_hit: F8,
@@ -717,10 +736,6 @@ impl PathLanes {
         let leaving = held.and(columns.wall.get(shape).ne(F8::splat(0.0))).and(on_sphere);
         if on_sphere.and_not(leaving).any() {
             let f = origin - center;
-            // Which root `roots` took (solved again: cheaper than tracking
-            // it through the search)
-            let (near_root, _, discriminant) = roots(f, direction, radius * radius);
-            let near = near_root.gt(F8::splat(0.0));
             let closest = f - direction * f.dot(direction);
             let half_chord = discriminant.max(F8::splat(0.0)).sqrt();
             let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
