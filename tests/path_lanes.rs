@@ -180,6 +180,26 @@ fn presets_of_planes_and_triangles_bit_for_bit() {
     }
 }
 
+/// More shapes than two permutes of eight hold: the lanes read the
+/// spheres', planes' and surfaces' fields by hardware gathers
+/// (`lanes::Column`), here the Cornell box with sixteen small balls of
+/// every material on its floor (18 spheres, 23 surfaces).
+#[test]
+fn more_than_sixteen_shapes_bit_for_bit() {
+    let mut scene = preset("cornell");
+    let materials = ["white", "red", "green", "mirror", "glass"];
+    for k in 0..16 {
+        let (x, z) = (-0.8 + 0.2 * (k % 8) as f32 + 0.05, if k < 8 { 0.6 } else { -0.8 });
+        scene.objects.push(Object {
+            name: format!("ball {k}"),
+            shape: Shape::Sphere { center: Vec3::new(x, 0.08, z), radius: 0.08 },
+            material: materials[k % materials.len()].to_string(),
+        });
+    }
+    let lit = assert_lanes_match_scalar(&scene, 32, 2);
+    assert!(lit > 1500, "only {lit} samples carried light");
+}
+
 /// Paths that start outside a wall (a wide lens beside the Cornell box's
 /// right wall: some rays start beyond it) meet every plane from either
 /// side and test walls for their shadow rays, beside paths held inside.
