@@ -338,7 +338,15 @@ mod tests {
                     );
                 }
             }
+            // Every fifth round one lane takes up a new stream, the others
+            // keeping theirs
+            if round % 5 == 4 {
+                let lane = round % LANES;
+                samplers[lane] = Sampler::new(100 + round as u64, 3, 9);
+                rng.start(M8::only(lane), samplers[lane].state());
+            }
         }
+        assert_eq!(rng.states(), std::array::from_fn(|i| samplers[i].state()));
     }
 
     /// `Real::powf` in the lanes is `pow::powf` lane by lane, bit for bit:
@@ -509,6 +517,13 @@ mod tests {
                     assert_eq!(got.to_array(), want.to_array());
                 }
             }
+            // One lane alone (none past the last), and every lane alike
+            let lane = start % (LANES + 2);
+            assert_eq!(M8::only(lane).to_array(), p::M8::only(lane).to_array(), "only lane {lane}");
+            assert_eq!(M8::only(lane).bits(), if lane < LANES { 1 << lane } else { 0 }, "only lane {lane}");
+            let value = a[0] < b[0];
+            assert_eq!(M8::splat(value).to_array(), p::M8::splat(value).to_array());
+            assert_eq!(M8::splat(value).bits(), if value { 0xff } else { 0 });
             let depths: [u32; LANES] = std::array::from_fn(|i| (a[i].to_bits() >> 28) + i as u32);
             let (count, p_count) = (Count8::from_array(depths), p::Count8::from_array(depths));
             for bound in [0, 3, 9, 20, u32::MAX] {
