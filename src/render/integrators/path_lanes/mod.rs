@@ -77,15 +77,10 @@ struct Surface {
 #[derive(Clone, Copy, Debug)]
 struct SphereInfo {
     center: Vec3,
-    radius: f32,
     radius2: f32,
-    /// Bound on the error of points computed on it (as `sphere_hit` gives).
-    error: f32,
     /// A wall (`occluders::Walls`), about its point nearest the camera:
-    /// paths inside every wall meet it only on their way out (`wall_exit`),
-    /// with this `wall_slack`.
+    /// paths inside every wall meet it only on their way out (`wall_exit`).
     wall: Option<AnchoredSphere>,
-    wall_slack: f32,
 }
 
 /// What a sphere's hit is rebuilt from, a column per field, indexed by
@@ -96,19 +91,24 @@ struct SphereColumns {
     radius: Column,
     /// 1 for a wall, 0 for any other sphere.
     wall: Column,
+    /// Bound on the error of points computed on it (as `sphere_hit` gives).
     error: Column,
+    /// A wall's `wall_slack` (0 for any other sphere).
     wall_slack: Column,
 }
 
 impl SphereColumns {
-    fn new(spheres: &[SphereInfo]) -> Self {
-        let column = |field: fn(&SphereInfo) -> f32| Column::new(spheres.iter().map(field));
+    /// For `spheres`, of radii `radii`.
+    fn new(spheres: &[SphereInfo], radii: &[f32]) -> Self {
+        let column = |field: &dyn Fn(&SphereInfo, f32) -> f32| {
+            Column::new(spheres.iter().zip(radii).map(|(sphere, &radius)| field(sphere, radius)))
+        };
         SphereColumns {
             center: Column3::new(spheres.iter().map(|s| s.center)),
-            radius: column(|s| s.radius),
-            wall: column(|s| s.wall.map_or(0.0, |_| 1.0)),
-            error: column(|s| s.error),
-            wall_slack: column(|s| s.wall_slack),
+            radius: column(&|_, radius| radius),
+            wall: column(&|s, _| s.wall.map_or(0.0, |_| 1.0)),
+            error: column(&|s, radius| gamma(6) * (s.center.abs().max_element() + radius)),
+            wall_slack: column(&|s, _| s.wall.map_or(0.0, |w| wall_slack(&w))),
         }
     }
 }
@@ -224,15 +224,8 @@ impl PathLanes {
         let wall = |i: usize| world.walls.wall_spheres.iter().find(|(j, _)| *j as usize == i).map(|(_, w)| *w);
         let spheres: Vec<SphereInfo> = (0..s.radius.len())
             .map(|i| {
-                let (center, radius) = (s.center(i), s.radius[i]);
-                SphereInfo {
-                    center,
-                    radius,
-                    radius2: radius * radius,
-                    error: gamma(6) * (center.abs().max_element() + radius),
-                    wall: wall(i),
-                    wall_slack: wall(i).map_or(0.0, |w| wall_slack(&w)),
-                }
+                let radius = s.radius[i];
+                SphereInfo { center: s.center(i), radius2: radius * radius, wall: wall(i) }
             })
             .collect();
         let planes: Vec<PlaneInfo> = (world.planes.iter())
@@ -273,7 +266,7 @@ impl PathLanes {
         Some(PathLanes {
             others: others.into_iter().map(occluder).collect(),
             walls: walls.into_iter().map(occluder).collect(),
-            sphere_columns: SphereColumns::new(&spheres),
+            sphere_columns: SphereColumns::new(&spheres, &s.radius),
             spheres,
             plane_normals: Column3::new(by_shape().map(|p| p.map_or(Vec3::ZERO, |p| p.normal))),
             plane_offsets: Column::new(by_shape().map(|p| p.map_or(0.0, |p| p.offset))),
