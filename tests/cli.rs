@@ -316,7 +316,14 @@ fn values_out_of_their_limits_are_refused_by_name() {
 /// Each algorithm takes only its own knobs: another's is refused by name.
 #[test]
 fn a_knob_of_another_algorithm_is_refused() {
-    for (algo, flag) in [("path", "--global-photons=10"), ("sppm", "--k=20"), ("photon", "--sppm-alpha=0.5")] {
+    let flags = [
+        ("path", "--global-photons=10"),
+        ("sppm", "--k=20"),
+        ("photon", "--sppm-alpha=0.5"),
+        ("bpm", "--merges=caustics"),
+        ("bdpt", "--merges=everywhere"),
+    ];
+    for (algo, flag) in flags {
         let output = gi_studio()
             .args(["render", "assets/scenes/cornell.ron", "-o", "never.png", "--algo", algo, flag])
             .output()

@@ -9,7 +9,7 @@ mod common;
 use common::valid;
 use std::sync::Arc;
 
-use gi_studio::render::{render_blocking, LinearImage, RenderJob, RenderSettings};
+use gi_studio::render::{render_blocking, LinearImage, Method, RenderJob, RenderSettings};
 use gi_studio::scene::presets;
 
 /// (preset, algorithm, FNV-1a of the image's f32 bits).
@@ -79,6 +79,14 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("glossy", "bdpt", 0x74bbf92aa5792038),
     ("glossy", "bpm", 0x35f6f40d372672f9),
     ("glossy", "vcm", 0x47ef822313a29bba),
+    ("cornell", "vcm+caustic", 0xf2ef124c07a298bb),
+    ("smallpt", "vcm+caustic", 0xf0460af83dc55a4a),
+    ("thesis", "vcm+caustic", 0x902f4db71801afe8),
+    ("lights", "vcm+caustic", 0x6a93aaf1eb908576),
+    ("caustics", "vcm+caustic", 0x6b00249e06a50adc),
+    ("mirror-caustic", "vcm+caustic", 0x2fabc348549c39ad),
+    ("gap-room", "vcm+caustic", 0xb2a247b586f370f8),
+    ("glossy", "vcm+caustic", 0x74bbf92aa5792038),
 ];
 
 pub fn image_hash(image: &LinearImage) -> u64 {
@@ -86,11 +94,11 @@ pub fn image_hash(image: &LinearImage) -> u64 {
     words.flat_map(u32::to_le_bytes).fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
 }
 
+/// `name` is an algorithm, with `+final-gather` (photon mapping) or
+/// `+caustic` (VCM merging on caustic paths only) after it.
 fn golden_render(preset: &str, name: &str) -> LinearImage {
-    let (algorithm, final_gather) = match name.split_once('+') {
-        Some((algorithm, _)) => (algorithm.parse().unwrap(), true),
-        None => (name.parse().unwrap(), false),
-    };
+    let (algorithm, variant) = name.split_once('+').unwrap_or((name, ""));
+    let algorithm = algorithm.parse().unwrap();
     let scene = presets::preset(preset).unwrap().unwrap();
     let mut settings = RenderSettings {
         width: 64,
@@ -101,7 +109,10 @@ fn golden_render(preset: &str, name: &str) -> LinearImage {
     };
     settings.set_photons(20_000);
     if let Some(p) = settings.photon_mut() {
-        (p.final_gather, p.final_gather_rays) = (final_gather, 4);
+        (p.final_gather, p.final_gather_rays) = (variant == "final-gather", 4);
+    }
+    if let Method::Vcm(m) = &mut settings.method {
+        m.caustic_merges = variant == "caustic";
     }
     render_blocking(&RenderJob::new(Arc::new(valid(scene)), settings)).unwrap().0
 }
@@ -116,4 +127,16 @@ fn every_preset_and_algorithm_renders_its_golden_image() {
         }
     }
     assert!(changed.is_empty(), "images changed; if intended, commit them on their own with:\n{}", changed.join("\n"));
+}
+
+/// Where no light passes a mirror or glass (lights, gap-room, glossy), VCM
+/// merging on caustic paths only has no merge to make and weighs every
+/// connection as BDPT does: its image is BDPT's, bit for bit. A merge's
+/// share left in any connection's weight would darken it.
+#[test]
+fn caustic_merges_without_mirrors_or_glass_are_bdpt() {
+    for preset in ["lights", "gap-room", "glossy"] {
+        let (vcm, bdpt) = (golden_render(preset, "vcm+caustic"), golden_render(preset, "bdpt"));
+        assert!(vcm.pixels == bdpt.pixels, "{preset}: VCM with caustic merges is not BDPT");
+    }
 }

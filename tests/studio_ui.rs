@@ -478,3 +478,37 @@ fn the_photon_plots_split_an_sppm_pass_into_its_stages() {
         assert!(ms.is_some_and(f64::is_finite) && after.contains(" ms"), "{label}");
     }
 }
+
+/// A VCM pane's settings say where it merges: the checkbox flips the
+/// pane's setting and renders it again; a BDPT pane, which never merges,
+/// offers no such box.
+#[test]
+fn a_vcm_pane_chooses_where_it_merges() {
+    use gi_studio::render::{Algorithm, Method};
+    let mut harness = studio(1);
+    let pane = &mut harness.state_mut().panes_mut().list_mut()[0];
+    pane.settings_mut().method = Method::of(Algorithm::Vcm);
+    harness.state_mut().restart_all();
+    harness.run_steps(2);
+    let caustics = |harness: &Harness<'static, StudioApp>| match &harness.state().panes().list()[0].settings().method {
+        Method::Vcm(m) => m.caustic_merges,
+        other => panic!("not VCM: {other:?}"),
+    };
+    let (before, generation) = (caustics(&harness), harness.state().panes().list()[0].state().generation);
+    harness.get_by_label("Settings").click();
+    harness.run_steps(2);
+    harness.get_by_label("merge caustic paths only").click();
+    harness.run_steps(2);
+    assert_eq!(caustics(&harness), !before, "the box did not flip the setting");
+    assert!(harness.state().panes().list()[0].state().generation > generation, "not rendered again");
+    let pane = &mut harness.state_mut().panes_mut().list_mut()[0];
+    pane.settings_mut().method = Method::of(Algorithm::Bdpt);
+    harness.run_steps(2);
+    // The menu open on BDPT's knobs (its heuristic)
+    if harness.query_by_label("balance").is_none() {
+        harness.get_by_label("Settings").click();
+        harness.run_steps(2);
+    }
+    harness.get_by_label("balance");
+    assert!(harness.query_by_label("merge caustic paths only").is_none(), "BDPT offers where to merge");
+}

@@ -413,6 +413,7 @@ impl Pane {
                 ui.radio_value(mis, MisHeuristic::Balance, "balance");
             });
         };
+        let vcm = matches!(s.method, Method::Vcm(_));
         match &mut s.method {
             Method::Whitted | Method::Path | Method::LightTracing => {}
             Method::Bdpt(b) => {
@@ -425,6 +426,12 @@ impl Pane {
                 let radius = egui::DragValue::new(&mut m.radius).range(0.0..=1e6).speed(0.001);
                 ui.add(radius.prefix("merge radius (0: auto) "));
                 ui.add(egui::Slider::new(&mut m.alpha, 0.05..=1.0).text("α"));
+                if vcm {
+                    let caustics = ui.checkbox(&mut m.caustic_merges, "merge caustic paths only");
+                    caustics.on_hover_text(
+                        "Merge only where light came through a mirror or glass; connections make every other path",
+                    );
+                }
             }
             Method::Photon(p) => {
                 ui.separator();

@@ -12,6 +12,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
+use super::merges::Merges;
 use super::outputs::Outputs;
 use super::reference::{render_reference, stem};
 use crate::analysis::convergence::{ConvergenceLog, ConvergencePoint};
@@ -23,7 +24,7 @@ use crate::analysis::reference::{
 use crate::fileio::{self, SIGNATURE};
 use crate::limits;
 use crate::render::{
-    Algorithm, LinearImage, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers,
+    Algorithm, LinearImage, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers,
 };
 use crate::scene::{load_scene, presets, ValidScene};
 
@@ -55,6 +56,9 @@ pub struct BenchArgs {
     /// Replace output files that GI Studio did not write.
     #[arg(long)]
     pub force: bool,
+    /// Where VCM merges: caustics or everywhere [default: the settings' default].
+    #[arg(long, value_enum)]
+    pub merges: Option<Merges>,
 }
 
 /// The CSV's first line, which also marks the file as this program's.
@@ -240,7 +244,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         println!("\n{name} at {width}×{height} for {} s per algorithm (reference: {made})", args.budget);
         let mut runs = Vec::new();
         for &algorithm in &args.algos {
-            let settings = RenderSettings {
+            let mut settings = RenderSettings {
                 width,
                 height,
                 time_limit: Some(args.budget),
@@ -248,6 +252,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 seed: args.seed,
                 ..RenderSettings::for_algorithm(algorithm)
             };
+            if let (Method::Vcm(m), Some(merges)) = (&mut settings.method, args.merges) {
+                merges.apply(m);
+            }
             let bar = ProgressBar::new((args.budget * 10.0).ceil() as u64).with_message(format!("{name} {algorithm}"));
             bar.set_style(
                 ProgressStyle::with_template("{msg:24} [{bar:40}] {elapsed}")

@@ -5,6 +5,7 @@
 pub mod bench;
 pub mod farm;
 pub mod merge;
+pub mod merges;
 pub mod outputs;
 pub mod photons;
 pub mod reference;
@@ -15,6 +16,7 @@ use clap::{Args, Parser, Subcommand};
 
 use crate::limits;
 use crate::render::{Algorithm, MergeSettings, Method, MisHeuristic, PhotonSettings, SppmSettings};
+use merges::Merges;
 
 /// The headless commands alone (the binary adds the studio's flags).
 #[derive(Debug, Parser)]
@@ -180,6 +182,9 @@ pub struct BidirFlags {
     /// Merge radius reduction α in (0, 1] (bpm, vcm).
     #[arg(long, value_parser = |s: &str| limits::SPPM_ALPHA.parse(s))]
     pub merge_alpha: Option<f32>,
+    /// Where VCM merges: caustics (only where light came through a mirror or glass; connections make every other path) or everywhere (Georgiev et al. 2012) [default: the settings' default].
+    #[arg(long, value_enum)]
+    pub merges: Option<Merges>,
 }
 
 impl BidirFlags {
@@ -193,14 +198,21 @@ impl BidirFlags {
             .find_map(|(given, name)| given.then_some(name))
     }
 
+    fn given_caustic(&self) -> Option<&'static str> {
+        self.merges.is_some().then_some("--merges")
+    }
+
     fn given(&self) -> Option<&'static str> {
-        self.given_mis().or(self.given_merge())
+        self.given_mis().or(self.given_merge()).or(self.given_caustic())
     }
 
     pub fn apply(&self, m: &mut MergeSettings) {
         m.mis = self.mis.unwrap_or(m.mis);
         m.radius = self.merge_radius.unwrap_or(m.radius);
         m.alpha = self.merge_alpha.unwrap_or(m.alpha);
+        if let Some(merges) = self.merges {
+            merges.apply(m);
+        }
     }
 }
 
@@ -221,9 +233,14 @@ impl RenderFlags {
             }
             Method::Bdpt(b) => {
                 b.mis = bidir.mis.unwrap_or(b.mis);
-                photon.given().or(sppm.given()).or(bidir.given_merge())
+                photon.given().or(sppm.given()).or(bidir.given_merge()).or(bidir.given_caustic())
             }
-            Method::Bpm(m) | Method::Vcm(m) => {
+            Method::Bpm(m) => {
+                bidir.apply(m);
+                // Merges are its only strategy
+                photon.given().or(sppm.given()).or(bidir.given_caustic())
+            }
+            Method::Vcm(m) => {
                 bidir.apply(m);
                 photon.given().or(sppm.given())
             }

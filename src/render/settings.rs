@@ -198,11 +198,14 @@ pub struct MergeSettings {
     pub mis: MisHeuristic,
     pub radius: f32,
     pub alpha: f32,
+    /// VCM only: merge only where light came through a mirror or glass
+    /// (caustic paths), leaving every other path to the connections.
+    pub caustic_merges: bool,
 }
 
 impl Default for MergeSettings {
     fn default() -> Self {
-        Self { mis: MisHeuristic::Power, radius: 0.0, alpha: 0.75 }
+        Self { mis: MisHeuristic::Power, radius: 0.0, alpha: 0.75, caustic_merges: false }
     }
 }
 

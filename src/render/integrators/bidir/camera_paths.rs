@@ -17,7 +17,7 @@ use glam::Vec3;
 
 use super::light_paths::{LightPaths, LightVertex};
 use super::merging::MergeGrid;
-use super::mis::{self, Partials};
+use super::mis::{self, MergeBehind, Partials};
 use super::strategies::{Contribution, NoTally, PixelTally, Strategy, Tally};
 use super::Context;
 use crate::geometry::Ray;
@@ -140,6 +140,8 @@ struct CameraPath<'w> {
     sampler: Sampler,
     scope: PathScope<'w>,
     partials: Partials,
+    /// A merge at the vertex it last left, counted if this one is specular.
+    behind: MergeBehind,
     throughput: Rgb,
     ray: Ray,
     last_point: Vec3,
@@ -197,6 +199,7 @@ pub fn trace(
             sampler,
             scope,
             partials: Partials::camera(&ctx.strategies, ctx.camera.ray_pdf(ray.direction)),
+            behind: MergeBehind::default(),
             throughput: Rgb::ONE,
             ray,
             last_point: ray.origin,
@@ -275,6 +278,7 @@ impl CameraPath<'_> {
         let distance =
             if length == 1 { hit.surface.t + ctx.camera.clip_distance(self.ray.direction) } else { hit.surface.t };
         self.partials.arrive(s, Some(distance * distance), wo.dot(n));
+        self.behind.arrive(s, wo.dot(n));
         let emitted = world.emitted(hit, wo);
         if emitted != Rgb::ZERO {
             let weight = emitter_weight(ctx, &self.partials, length, self.specular_path, hit, wo, self.last_point);
@@ -288,7 +292,10 @@ impl CameraPath<'_> {
         }
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
         let sampler = &mut self.sampler;
-        if !bsdf.is_specular() {
+        if bsdf.is_specular() {
+            // Light came to the vertex before through this one
+            self.partials.merge_behind(s, self.behind);
+        } else {
             let vertex = CameraVertex { hit, wo, facing, bsdf: &bsdf, partials: &self.partials, length };
             if s.connect {
                 let picked = match drawn {
@@ -325,7 +332,16 @@ impl CameraPath<'_> {
             return false;
         }
         let reverse = if scattered.delta { scattered.pdf } else { bsdf.pdf(scattered.wi, wo, facing) };
-        self.partials.scatter(s, scattered.pdf * go_on, reverse * go_on, scattered.wi.dot(n), scattered.delta);
+        // Whether a merge here is a strategy can hang on the next vertex
+        let merges_here = s.merges_at(false);
+        self.behind = self.partials.scatter(
+            s,
+            scattered.pdf * go_on,
+            reverse * go_on,
+            scattered.wi.dot(n),
+            scattered.delta,
+            merges_here,
+        );
         self.throughput *= scattered.weight / go_on;
         self.specular_path &= scattered.delta;
         if self.throughput == Rgb::ZERO {
@@ -466,8 +482,16 @@ fn connect(
     let light_pdf_a = light_pdf * light_go_on * cos_camera / distance2;
     let light_reverse = light.bsdf.pdf(-direction, light.wo, light_facing) * light_go_on;
     let s = &ctx.strategies;
-    let weight =
-        mis::connect(s, &light.partials, vertex.partials, camera_pdf_a, light_pdf_a, light_reverse, camera_reverse);
+    let weight = mis::connect(
+        s,
+        &light.partials,
+        vertex.partials,
+        camera_pdf_a,
+        light_pdf_a,
+        light_reverse,
+        camera_reverse,
+        light.after_specular,
+    );
     let contribution = light.throughput * camera_f * light_f * (weight * cos_camera * cos_light / distance2);
     counters.connections += 1;
     counters.rays += 1;
@@ -489,7 +513,8 @@ fn merge(
     counters: &mut Counters,
     found: &mut Found,
 ) -> Rgb {
-    let Some(grid) = light.grid else { return Rgb::ZERO };
+    // Caustic merges only in a scene with no caustic path: no query
+    let Some(grid) = light.grid.filter(|grid| !grid.is_empty()) else { return Rgb::ZERO };
     let normalization = ctx.strategies.vm_normalization;
     let (wo, facing, bsdf) = (vertex.wo, vertex.facing, vertex.bsdf);
     let go_on = bsdf.continuation();
@@ -533,11 +558,11 @@ mod tests {
     use crate::render::world::World;
     use crate::scene::presets;
 
-    /// Every preset, connecting and merging (VCM), the strategy view open
-    /// or not: the camera subpaths of a tile flown eight at a time, their
-    /// shadow rays traced in lanes, make what one at a time with every
-    /// shadow ray alone makes — the same pixels, contributions and counts,
-    /// bit for bit.
+    /// Every preset, connecting and merging (VCM, merges everywhere or on
+    /// caustic paths only), the strategy view open or not: the camera
+    /// subpaths of a tile flown eight at a time, their shadow rays traced in
+    /// lanes, make what one at a time with every shadow ray alone makes —
+    /// the same pixels, contributions and counts, bit for bit.
     #[test]
     fn eight_at_a_time_make_what_one_at_a_time_make() {
         assert!(PathLanes::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
@@ -551,12 +576,12 @@ mod tests {
             let picker = LightPicker::new(&world);
             let pixels = (width * height) as f32;
             let radius = visible_radius * 0.01;
-            for strategy_film in [None, Some(&film)] {
+            for (strategy_film, caustics) in [(None, false), (Some(&film), false), (None, true)] {
                 let lanes_ctx = Context {
                     world: &world,
                     path_lanes: Some(&path_lanes),
                     camera: &camera,
-                    strategies: Strategies::new(MisHeuristic::Power, true, true, pixels, radius),
+                    strategies: Strategies::with_merges(MisHeuristic::Power, true, true, caustics, pixels, radius),
                     picker: &picker,
                     bounds: world.bounds(),
                     background: world.lights.iter().position(|l| matches!(l, LightSource::Background { .. })),
@@ -566,7 +591,7 @@ mod tests {
                 };
                 let scalar_ctx = Context { path_lanes: None, ..lanes_ctx };
                 let paths = light_paths::trace(&lanes_ctx, pixels as u64, 2, 5, &|| true).expect("not cancelled");
-                let grid = MergeGrid::build(&paths, radius, Default::default());
+                let grid = MergeGrid::build(&paths, radius, caustics, Default::default());
                 let light = LightSide { paths: &paths, grid: Some(&grid), radius };
                 // A tile that does not split into eights, away from the corner
                 let rect = TileRect { x: 3, y: 5, width: 29, height: 11 };
@@ -580,9 +605,9 @@ mod tests {
                 };
                 let (eight, one) = (run(&lanes_ctx), run(&scalar_ctx));
                 let view = strategy_film.is_some();
-                assert!(eight.0 == one.0, "{name}, view {view}: the pixels differ");
-                assert_eq!(eight.1, one.1, "{name}, view {view}: the contributions differ");
-                assert_eq!(eight.2, one.2, "{name}, view {view}");
+                assert!(eight.0 == one.0, "{name}, view {view}, caustics {caustics}: the pixels differ");
+                assert_eq!(eight.1, one.1, "{name}, view {view}, caustics {caustics}: the contributions differ");
+                assert_eq!(eight.2, one.2, "{name}, view {view}, caustics {caustics}");
                 let lit = eight.0.iter().filter(|v| v.iter().any(|&c| c != 0)).count();
                 assert!(lit > rect.pixels() / 4, "{name}: only {lit} pixels lit");
                 if view {

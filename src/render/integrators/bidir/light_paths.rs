@@ -50,6 +50,8 @@ pub struct LightVertex {
     pub partials: Partials,
     /// Whether its subpath started inside every wall (`PathScope::held`).
     pub held: bool,
+    /// Whether light came to it through a mirror or glass.
+    pub after_specular: bool,
 }
 
 impl LightVertex {
@@ -207,6 +209,8 @@ struct Flight<'w> {
     partials: Partials,
     /// Segments from the light, `ray`'s included.
     length: u32,
+    /// Whether it last left a mirror or glass.
+    after_specular: bool,
 }
 
 /// Light subpaths find how the camera sees their vertices and draw their
@@ -259,6 +263,7 @@ impl<'w> Flights<'_, 'w> {
             throughput: emission.power / pick,
             partials: Partials::light(s, emission.pdf * pick, emission.cos, light.is_delta()),
             length: 1,
+            after_specular: false,
         })
     }
 
@@ -280,8 +285,9 @@ impl<'w> Flights<'_, 'w> {
         let bsdf = Bsdf::new(world.material_of(hit));
         let sampler = &mut path.sampler;
         if !bsdf.is_specular() {
-            let (throughput, partials, held) = (path.throughput, path.partials, path.scope.held);
-            let vertex = LightVertex { hit: hit.surface, wo, bsdf, throughput, length, partials, held };
+            let (throughput, partials, held, after_specular) =
+                (path.throughput, path.partials, path.scope.held, path.after_specular);
+            let vertex = LightVertex { hit: hit.surface, wo, bsdf, throughput, length, partials, held, after_specular };
             if ctx.keeps_vertices() {
                 out.vertices.push(vertex);
             }
@@ -311,7 +317,18 @@ impl<'w> Flights<'_, 'w> {
         }
         let facing = if wo.dot(n) < 0.0 { -n } else { n };
         let reverse = if scattered.delta { scattered.pdf } else { bsdf.pdf(scattered.wi, wo, facing) };
-        path.partials.scatter(s, scattered.pdf * go_on, reverse * go_on, scattered.wi.dot(n), scattered.delta);
+        let merges_here = s.merges_at(path.after_specular);
+        // A light subpath knows at once whether a merge here is a strategy,
+        // so nothing is left behind to count later
+        path.partials.scatter(
+            s,
+            scattered.pdf * go_on,
+            reverse * go_on,
+            scattered.wi.dot(n),
+            scattered.delta,
+            merges_here,
+        );
+        path.after_specular = scattered.delta;
         path.throughput *= scattered.weight / go_on;
         if path.throughput == Rgb::ZERO {
             return false;
@@ -385,7 +402,7 @@ fn join_camera(
         1.0
     } else {
         let reverse = vertex.bsdf.pdf(seen.to_camera, vertex.wo, facing) * vertex.bsdf.continuation();
-        mis::to_camera(&ctx.strategies, &vertex.partials, camera_pdf_a, reverse)
+        mis::to_camera(&ctx.strategies, &vertex.partials, camera_pdf_a, reverse, vertex.after_specular)
     };
     let value = vertex.throughput * f * (weight * camera_pdf_a / ctx.strategies.light_paths);
     let (shadow, t_max) = vertex.hit.spawn_ray_to(seen.lens, 0.0);

@@ -8,7 +8,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::light_paths::LightPaths;
+use super::light_paths::{LightPaths, LightVertex};
 use super::mis::Partials;
 use crate::render::integrators::photon_map::cells::PointGrid;
 use crate::scene::Rgb;
@@ -55,11 +55,19 @@ pub struct MergeBuffers {
 
 impl MergeGrid {
     /// The grid of `paths`' vertices for merges within `radius` (cells
-    /// `MERGE_CELLS` radii wide), in `buffers`.
-    pub fn build(paths: &LightPaths, radius: f32, buffers: MergeBuffers) -> Self {
+    /// `MERGE_CELLS` radii wide), in `buffers`; with `caustics_only`, only
+    /// the vertices light came to through a mirror or glass.
+    pub fn build(paths: &LightPaths, radius: f32, caustics_only: bool, buffers: MergeBuffers) -> Self {
+        let keep = |v: &&LightVertex| !caustics_only || v.after_specular;
         // The vertices read in sequence here, so that only small records
         // are gathered in the grid's order; each chunk into its own stretch
-        let count = paths.chunks.iter().map(|chunk| chunk.vertices.len()).sum();
+        let counts: Vec<usize> = (paths.chunks.iter())
+            .map(|chunk| match caustics_only {
+                true => chunk.vertices.iter().filter(keep).count(),
+                false => chunk.vertices.len(),
+            })
+            .collect();
+        let count = counts.iter().sum();
         let MergeBuffers { by_vertex: mut merged, by_slot: mut vertices, mut positions } = buffers;
         // Every entry below `count` is written below
         merged.truncate(count);
@@ -68,14 +76,14 @@ impl MergeGrid {
         positions.resize(count, Vec3::ZERO);
         let mut stretches = Vec::with_capacity(paths.chunks.len());
         let (mut positions_left, mut merged_left) = (&mut positions[..], &mut merged[..]);
-        for chunk in &paths.chunks {
-            let (here, rest) = std::mem::take(&mut positions_left).split_at_mut(chunk.vertices.len());
-            let (merged_here, merged_rest) = std::mem::take(&mut merged_left).split_at_mut(chunk.vertices.len());
+        for (chunk, &count) in paths.chunks.iter().zip(&counts) {
+            let (here, rest) = std::mem::take(&mut positions_left).split_at_mut(count);
+            let (merged_here, merged_rest) = std::mem::take(&mut merged_left).split_at_mut(count);
             stretches.push((chunk, here, merged_here));
             (positions_left, merged_left) = (rest, merged_rest);
         }
         stretches.into_par_iter().for_each(|(chunk, positions, merged)| {
-            for (v, (position, merged)) in chunk.vertices.iter().zip(positions.iter_mut().zip(merged)) {
+            for (v, (position, merged)) in chunk.vertices.iter().filter(keep).zip(positions.iter_mut().zip(merged)) {
                 *position = v.hit.point;
                 *merged = MergeVertex {
                     wo: v.wo,
@@ -97,10 +105,71 @@ impl MergeGrid {
         MergeBuffers { by_vertex, by_slot: self.vertices, positions }
     }
 
+    /// Whether it holds no vertex (no query can find one).
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
     /// Every light vertex within `radius` of `point` (squared distance ≤
     /// radius²), in an order fixed by the vertices and the query alone.
     #[inline]
     pub fn for_each_within(&self, point: Vec3, radius: f32, mut f: impl FnMut(&MergeVertex)) {
         self.points.for_each_slot_within(point, radius, |slot| f(&self.vertices[slot]));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::integrators::bidir::light_paths;
+    use crate::render::integrators::bidir::mis::Strategies;
+    use crate::render::integrators::bidir::Context;
+    use crate::render::integrators::photon_map::emit::LightPicker;
+    use crate::render::settings::MisHeuristic;
+    use crate::render::world::camera::CameraModel;
+    use crate::render::world::World;
+    use crate::scene::presets;
+
+    /// On the caustic preset, a grid of caustic merges holds exactly the
+    /// light vertices light came to through the glass or a mirror (some,
+    /// not all, none fewer than two segments from the light); the full
+    /// grid holds every vertex. Each vertex is found by a query at its own
+    /// position, and only those the grid holds.
+    #[test]
+    fn caustic_merges_keep_the_vertices_light_came_to_through_a_specular_one() {
+        let (width, height) = (40, 30);
+        let scene = presets::preset("mirror-caustic").and_then(Result::ok).expect("preset");
+        let camera = CameraModel::new(&scene.camera, width, height);
+        let (world, visible_radius) = World::for_view(&scene, &camera, width, height);
+        let picker = LightPicker::new(&world);
+        let (pixels, radius) = ((width * height) as f32, visible_radius * 0.01);
+        let ctx = Context {
+            world: &world,
+            path_lanes: None,
+            camera: &camera,
+            strategies: Strategies::with_merges(MisHeuristic::Power, true, true, true, pixels, radius),
+            picker: &picker,
+            bounds: world.bounds(),
+            background: None,
+            max_length: 8,
+            light_tracing: false,
+            strategy_film: None,
+        };
+        let paths = light_paths::trace(&ctx, pixels as u64, 0, 3, &|| true).expect("not cancelled");
+        let vertices: Vec<&LightVertex> = paths.chunks.iter().flat_map(|chunk| &chunk.vertices).collect();
+        let caustic: Vec<&&LightVertex> = vertices.iter().filter(|v| v.after_specular).collect();
+        assert!(!caustic.is_empty() && caustic.len() < vertices.len(), "{} of {}", caustic.len(), vertices.len());
+        assert!(caustic.iter().all(|v| v.length >= 2));
+        let found = |grid: &MergeGrid, v: &LightVertex| {
+            let mut found = false;
+            grid.for_each_within(v.hit.point, radius, |m| found |= m.wo == v.wo && m.length == v.length);
+            found
+        };
+        let full = MergeGrid::build(&paths, radius, false, MergeBuffers::default());
+        assert_eq!(full.points.len(), vertices.len());
+        assert!(vertices.iter().all(|v| found(&full, v)));
+        let caustics = MergeGrid::build(&paths, radius, true, full.into_buffers());
+        assert_eq!(caustics.points.len(), caustic.len());
+        assert!(vertices.iter().all(|v| found(&caustics, v) == v.after_specular));
     }
 }

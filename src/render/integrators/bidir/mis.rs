@@ -26,6 +26,14 @@ pub struct Strategies {
     /// Vertex merging: camera vertices gather the light vertices within
     /// the merge radius.
     pub merge: bool,
+    /// Merges only where light came to the vertex through a mirror or
+    /// glass (a caustic path), which no connection can make; every other
+    /// path is left to the connections, which make it without the merge's
+    /// blur, and the query for most camera vertices is skipped
+    /// (Grittmann et al., "Efficient Caustic Rendering with Lightweight
+    /// Photon Mapping", 2018). A merge at a vertex is a strategy of the path
+    /// by this rule alone, so the weights still sum to one.
+    pub caustic_merges: bool,
     /// Light subpaths per pass (one a pixel).
     pub light_paths: f32,
     /// mis(η) where merging is on, η = π r² · light paths: how a merge
@@ -40,16 +48,48 @@ pub struct Strategies {
 impl Strategies {
     /// For a pass of `light_paths` subpaths merging within `radius`.
     pub fn new(heuristic: MisHeuristic, connect: bool, merge: bool, light_paths: f32, radius: f32) -> Self {
+        Self::with_merges(heuristic, connect, merge, false, light_paths, radius)
+    }
+
+    /// As `new`, merging only on caustic paths if `caustic_merges` (and
+    /// merging at all).
+    pub fn with_merges(
+        heuristic: MisHeuristic,
+        connect: bool,
+        merge: bool,
+        caustic_merges: bool,
+        light_paths: f32,
+        radius: f32,
+    ) -> Self {
         let mis = |x: f64| heuristic.apply(x);
         let eta = std::f64::consts::PI * (radius as f64).powi(2) * light_paths as f64;
         Strategies {
             heuristic,
             connect,
             merge,
+            caustic_merges: merge && caustic_merges,
             light_paths,
             vm_weight: if merge { mis(eta) } else { 0.0 },
             vc_weight: if connect { mis(1.0 / eta) } else { 0.0 },
             vm_normalization: (1.0 / eta) as f32,
+        }
+    }
+
+    /// Whether a merge at a non-specular vertex is a strategy, light
+    /// having come to it through a specular vertex if `after_specular`.
+    #[inline]
+    pub fn merges_at(&self, after_specular: bool) -> bool {
+        self.merge && (after_specular || !self.caustic_merges)
+    }
+
+    /// A merge's weight against a connection at such a vertex, 0 where it
+    /// is not a strategy.
+    #[inline]
+    fn vm_weight_at(&self, after_specular: bool) -> f64 {
+        if self.merges_at(after_specular) {
+            self.vm_weight
+        } else {
+            0.0
         }
     }
 
@@ -135,18 +175,54 @@ impl Partials {
     /// Leaving a vertex along a direction sampled with density `pdf`, whose
     /// reverse density (sampling the way back) is `reverse_pdf`, at cosine
     /// `cos_out`; `specular` for a delta lobe [report (34)–(36), (53)–(55)].
+    /// A merge at the vertex is counted if `merges_here`; if not, what it
+    /// would have added is returned, for a camera subpath that learns only
+    /// at its next vertex whether the merge is a strategy (`merge_behind`).
     #[inline]
-    pub fn scatter(&mut self, s: &Strategies, pdf: f32, reverse_pdf: f32, cos_out: f32, specular: bool) {
+    pub fn scatter(
+        &mut self,
+        s: &Strategies,
+        pdf: f32,
+        reverse_pdf: f32,
+        cos_out: f32,
+        specular: bool,
+        merges_here: bool,
+    ) -> MergeBehind {
         let g = s.mis64(cos_out.abs() as f64 / pdf as f64);
         if specular {
             self.vcm = 0.0;
             self.vc *= g * s.mis(reverse_pdf);
             self.vm *= g * s.mis(reverse_pdf);
+            MergeBehind(0.0)
         } else {
-            self.vc = g * (self.vc * s.mis(reverse_pdf) + self.vcm + s.vm_weight);
-            self.vm = g * (self.vm * s.mis(reverse_pdf) + self.vcm * s.vc_weight + 1.0);
+            let (vm_weight, one) = if merges_here { (s.vm_weight, 1.0) } else { (0.0, 0.0) };
+            self.vc = g * (self.vc * s.mis(reverse_pdf) + self.vcm + vm_weight);
+            self.vm = g * (self.vm * s.mis(reverse_pdf) + self.vcm * s.vc_weight + one);
             self.vcm = s.mis64(1.0 / pdf as f64);
+            MergeBehind(if merges_here { 0.0 } else { g })
         }
+    }
+
+    /// Counts the merge at the vertex before, which `scatter` left out:
+    /// light reached this vertex's way through a specular one.
+    #[inline]
+    pub fn merge_behind(&mut self, s: &Strategies, behind: MergeBehind) {
+        self.vc += behind.0 * s.vm_weight;
+        self.vm += behind.0;
+    }
+}
+
+/// What a merge at the vertex a subpath last left would add to its
+/// partials, not yet counted.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MergeBehind(f64);
+
+impl MergeBehind {
+    /// Carried over a segment to a vertex at cosine `cos`, as `arrive`
+    /// carries the partials.
+    #[inline]
+    pub fn arrive(&mut self, s: &Strategies, cos: f32) {
+        self.0 *= 1.0 / s.mis(cos.abs());
     }
 }
 
@@ -182,14 +258,17 @@ pub fn direct(
 ) -> f32 {
     let light_side = s.mis64(bsdf_pdf as f64 / (pick as f64 * direct_pdf as f64));
     let ratio = emission_pdf as f64 * cos_at_camera as f64 / (direct_pdf as f64 * cos_at_light as f64);
-    let camera_side = s.mis64(ratio) * (s.vm_weight + camera.vcm + camera.vc * s.mis(bsdf_reverse_pdf));
+    // A merge at the camera vertex: light came to it straight from the light
+    let camera_side = s.mis64(ratio) * (s.vm_weight_at(false) + camera.vcm + camera.vc * s.mis(bsdf_reverse_pdf));
     weight(light_side + camera_side)
 }
 
 /// A connection of a light vertex and a camera vertex: the camera BSDF's
 /// density of the light vertex per area `camera_pdf_a` and the light BSDF's
 /// of the camera vertex `light_pdf_a`; each side's reverse densities per
-/// solid angle [report (40)–(41)].
+/// solid angle; whether light came to the light vertex through a specular
+/// one [report (40)–(41)].
+#[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn connect(
     s: &Strategies,
@@ -199,19 +278,30 @@ pub fn connect(
     light_pdf_a: f32,
     light_reverse_pdf: f32,
     camera_reverse_pdf: f32,
+    light_after_specular: bool,
 ) -> f32 {
-    let light_side = s.mis(camera_pdf_a) * (s.vm_weight + light.vcm + light.vc * s.mis(light_reverse_pdf));
-    let camera_side = s.mis(light_pdf_a) * (s.vm_weight + camera.vcm + camera.vc * s.mis(camera_reverse_pdf));
+    let light_merge = s.vm_weight_at(light_after_specular);
+    let light_side = s.mis(camera_pdf_a) * (light_merge + light.vcm + light.vc * s.mis(light_reverse_pdf));
+    // A merge at the camera vertex: light came to it from the light vertex
+    let camera_merge = s.vm_weight_at(false);
+    let camera_side = s.mis(light_pdf_a) * (camera_merge + camera.vcm + camera.vc * s.mis(camera_reverse_pdf));
     weight(light_side + camera_side)
 }
 
 /// A light vertex joined to the camera (t = 1): the camera's density of it
 /// per area `camera_pdf_a` (its ray density times cos/d²), the light
-/// BSDF's reverse density [report (46)–(47)].
+/// BSDF's reverse density, whether light came to the vertex through a
+/// specular one [report (46)–(47)].
 #[inline]
-pub fn to_camera(s: &Strategies, light: &Partials, camera_pdf_a: f32, light_reverse_pdf: f32) -> f32 {
+pub fn to_camera(
+    s: &Strategies,
+    light: &Partials,
+    camera_pdf_a: f32,
+    light_reverse_pdf: f32,
+    after_specular: bool,
+) -> f32 {
     let light_side = s.mis64(camera_pdf_a as f64 / s.light_paths as f64)
-        * (s.vm_weight + light.vcm + light.vc * s.mis(light_reverse_pdf));
+        * (s.vm_weight_at(after_specular) + light.vcm + light.vc * s.mis(light_reverse_pdf));
     weight(light_side)
 }
 

@@ -65,6 +65,8 @@ pub struct Bidir {
     /// The merge radius of the first pass, and its reduction α.
     radius: f32,
     alpha: f32,
+    /// VCM merging only on caustic paths (`Strategies::caustic_merges`).
+    caustic_merges: bool,
     max_length: u32,
     seed: u64,
     picker: LightPicker,
@@ -114,11 +116,12 @@ impl Bidir {
     /// room's corners at 2%, 20 times too bright, and held VCM's error
     /// above BDPT's at equal passes).
     pub fn new(world: &World, settings: &RenderSettings, visible_radius: f32) -> Self {
-        let (mode, heuristic, radius, alpha) = match &settings.method {
-            Method::Bdpt(b) => (Mode::Connect, b.mis, 0.0, 1.0),
-            Method::Bpm(m) => (Mode::Merge, m.mis, m.radius, m.alpha),
-            Method::Vcm(m) => (Mode::ConnectAndMerge, m.mis, m.radius, m.alpha),
-            _ => (Mode::LightTracing, MisHeuristic::Power, 0.0, 1.0),
+        let (mode, heuristic, radius, alpha, caustic_merges) = match &settings.method {
+            Method::Bdpt(b) => (Mode::Connect, b.mis, 0.0, 1.0, false),
+            // Merges are its only strategy: each path needs them
+            Method::Bpm(m) => (Mode::Merge, m.mis, m.radius, m.alpha, false),
+            Method::Vcm(m) => (Mode::ConnectAndMerge, m.mis, m.radius, m.alpha, m.caustic_merges),
+            _ => (Mode::LightTracing, MisHeuristic::Power, 0.0, 1.0, false),
         };
         let share = if mode == Mode::ConnectAndMerge { 0.005 } else { 0.02 };
         let radius = if radius > 0.0 { radius } else { (visible_radius * share).max(1e-6) };
@@ -127,6 +130,7 @@ impl Bidir {
             heuristic,
             radius,
             alpha,
+            caustic_merges,
             max_length: settings.max_depth.max(1),
             seed: settings.seed,
             picker: LightPicker::new(world),
@@ -155,7 +159,7 @@ impl Bidir {
     fn weighing(&self, pass: u32, pixels: f32) -> Strategies {
         let connect = matches!(self.mode, Mode::Connect | Mode::ConnectAndMerge);
         let merge = matches!(self.mode, Mode::Merge | Mode::ConnectAndMerge);
-        Strategies::new(self.heuristic, connect, merge, pixels, self.merge_radius(pass))
+        Strategies::with_merges(self.heuristic, connect, merge, self.caustic_merges, pixels, self.merge_radius(pass))
     }
 
     /// One pass: the light subpaths, then the camera subpaths tile by tile,
@@ -190,7 +194,9 @@ impl Bidir {
         let keep_going = || observer.is_current();
         let paths = light_paths::trace(&ctx, pixels, pass as u64, self.seed, &keep_going)?;
         let radius = self.merge_radius(pass);
-        let grid = weighing.merge.then(|| MergeGrid::build(&paths, radius, std::mem::take(&mut self.merge_buffers)));
+        let grid = weighing.merge.then(|| {
+            MergeGrid::build(&paths, radius, weighing.caustic_merges, std::mem::take(&mut self.merge_buffers))
+        });
         if !observer.is_current() {
             return None;
         }
