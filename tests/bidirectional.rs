@@ -340,10 +340,9 @@ fn every_method_agrees_with_converged_path_tracing() {
     for (name, scene) in scenes {
         let reference = render(&scene, settings(Algorithm::Path, width, height, 4096)).0;
         let converged = reference.mean();
-        for (algorithm, passes) in
-            [(Algorithm::LightTracing, 64), (Algorithm::Bdpt, 64), (Algorithm::Bpm, 1024), (Algorithm::Vcm, 64)]
-        {
-            let mut s = settings(algorithm, width, height, passes);
+        for (algorithm, everywhere, algorithm_name) in methods() {
+            let passes = if algorithm == Algorithm::Bpm { 1024 } else { 64 };
+            let mut s = merging_everywhere(settings(algorithm, width, height, passes), everywhere);
             let a = render(&scene, s.clone()).0;
             s.seed += 1;
             let b = render(&scene, s).0;
@@ -352,29 +351,45 @@ fn every_method_agrees_with_converged_path_tracing() {
                 let deviation = mean[c] / converged[c] - 1.0;
                 assert!(
                     deviation.abs() < 0.01,
-                    "{name}, {algorithm}: channel {c} mean off by {:+.2}%",
+                    "{name}, {algorithm_name}: channel {c} mean off by {:+.2}%",
                     deviation * 100.0
                 );
             }
             let error = rel_mse(&a, &reference, RelMseOptions::default()).unwrap();
             let noise = rel_mse(&a, &b, RelMseOptions::default()).unwrap() / 2.0;
-            println!("{name}, {algorithm}: relMSE {error:.2e}, its noise {noise:.2e} (ratio {:.2})", error / noise);
-            assert!(error < 2.0 * noise, "{name}, {algorithm}: relMSE {error:.2e} against its noise {noise:.2e}");
+            println!(
+                "{name}, {algorithm_name}: relMSE {error:.2e}, its noise {noise:.2e} (ratio {:.2})",
+                error / noise
+            );
+            assert!(error < 2.0 * noise, "{name}, {algorithm_name}: relMSE {error:.2e} against its noise {noise:.2e}");
         }
     }
 }
 
-/// VCM's settings merging only on caustic paths.
-fn caustic_vcm(mut s: gi_studio::render::RenderSettings) -> gi_studio::render::RenderSettings {
+/// VCM's settings merging everywhere (Georgiev et al. 2012), not only on
+/// caustic paths, where `everywhere`.
+fn merging_everywhere(mut s: gi_studio::render::RenderSettings, everywhere: bool) -> gi_studio::render::RenderSettings {
     if let gi_studio::render::Method::Vcm(m) = &mut s.method {
-        m.caustic_merges = true;
+        m.caustic_merges &= !everywhere;
     }
     s
 }
 
+/// The four methods, VCM both ways: each with whether it merges
+/// everywhere, and its name.
+fn methods() -> [(gi_studio::render::Algorithm, bool, &'static str); 5] {
+    use gi_studio::render::Algorithm;
+    [
+        (Algorithm::LightTracing, false, "light tracing"),
+        (Algorithm::Bdpt, false, "BDPT"),
+        (Algorithm::Bpm, false, "BPM"),
+        (Algorithm::Vcm, false, "VCM"),
+        (Algorithm::Vcm, true, "VCM merging everywhere"),
+    ]
+}
+
 /// The Cornell box as shipped, mirror and glass balls and all: BDPT's and
-/// VCM's means (VCM's with merges everywhere and on caustic paths only)
-/// are converged path tracing's within 1% per channel (their σ at 128
+/// VCM's means (VCM's merging on caustic paths only, and everywhere) are converged path tracing's within 1% per channel (their σ at 128
 /// passes of 40×30, about 0.3%), and so are their errors' sizes. A caustic
 /// rule that left a merge's share in the other strategies' weights, or
 /// merged where it weighs nothing, darkens or brightens the glass ball's
@@ -389,7 +404,7 @@ fn bdpt_and_vcm_agree_with_path_tracing_on_the_cornell_box() {
     let methods = [
         ("BDPT", settings(Algorithm::Bdpt, 40, 30, 128)),
         ("VCM", settings(Algorithm::Vcm, 40, 30, 128)),
-        ("VCM, caustic merges", caustic_vcm(settings(Algorithm::Vcm, 40, 30, 128))),
+        ("VCM merging everywhere", merging_everywhere(settings(Algorithm::Vcm, 40, 30, 128), true)),
     ];
     for (name, method) in methods {
         let image = render(&scene, method).0;
@@ -409,7 +424,7 @@ fn bdpt_and_vcm_agree_with_path_tracing_on_the_cornell_box() {
 /// (camera, diffuse, mirror, diffuse, …, light): merges at the first
 /// diffuse vertex are then strategies, and at a radius where they weigh
 /// most (η = πr²·paths ≈ 9), VCM with caustic merges holds BDPT's mean
-/// within 1% per channel. A camera subpath that never counted such a merge
+/// within 1% per channel (VCM's default). A camera subpath that never counted such a merge
 /// in its partials weighs its later connections as if they were alone,
 /// and counts that light twice.
 #[test]
@@ -419,8 +434,9 @@ fn caustic_merges_weigh_against_connections_beyond_a_mirror() {
     let back_wall = scene.objects.iter().position(|o| o.name == "back wall").unwrap();
     scene.objects[back_wall].material = "mirror".into();
     let bdpt = render(&scene, settings(Algorithm::Bdpt, 40, 30, 256)).0.mean();
-    let mut s = caustic_vcm(settings(Algorithm::Vcm, 40, 30, 256));
+    let mut s = settings(Algorithm::Vcm, 40, 30, 256);
     if let Method::Vcm(m) = &mut s.method {
+        assert!(m.caustic_merges, "VCM merges on caustic paths alone by default");
         m.radius = 0.05;
     }
     let vcm = render(&scene, s).0.mean();
@@ -438,14 +454,12 @@ fn caustic_merges_weigh_against_connections_beyond_a_mirror() {
 /// merges blur by their radius, within 2% too.
 #[test]
 fn a_furnace_holds_its_closed_form_for_every_method() {
-    use gi_studio::render::Algorithm;
     let furnace = common::detectors::furnace_scene(0.5);
-    for algorithm in [Algorithm::LightTracing, Algorithm::Bdpt, Algorithm::Bpm, Algorithm::Vcm] {
-        let means: Vec<f64> = common::detectors::replicas(&furnace, settings(algorithm, 16, 12, 16), 8)
-            .iter()
-            .map(|image| mean_luminance(&image.pixels))
-            .collect();
-        let what = format!("{algorithm} in the furnace");
+    for (algorithm, everywhere, name) in methods() {
+        let s = merging_everywhere(settings(algorithm, 16, 12, 16), everywhere);
+        let means: Vec<f64> =
+            common::detectors::replicas(&furnace, s, 8).iter().map(|image| mean_luminance(&image.pixels)).collect();
+        let what = format!("{name} in the furnace");
         if let Err(e) = common::detectors::t_test(&what, &means, 1.0, 1e-4) {
             panic!("{e}");
         }
@@ -457,15 +471,15 @@ fn a_furnace_holds_its_closed_form_for_every_method() {
 /// order, the merge tree built from them in that order.
 #[test]
 fn the_same_seed_gives_the_same_image_on_any_number_of_threads() {
-    use gi_studio::render::{render_blocking_on, Algorithm, RenderJob, Workers};
+    use gi_studio::render::{render_blocking_on, RenderJob, Workers};
     let scene = std::sync::Arc::new(valid(gi_studio::scene::presets::preset("cornell").unwrap().unwrap()));
     let (one, two) = (Workers::new(1).unwrap(), Workers::new(2).unwrap());
-    for algorithm in [Algorithm::LightTracing, Algorithm::Bdpt, Algorithm::Bpm, Algorithm::Vcm] {
-        let job = RenderJob::new(scene.clone(), settings(algorithm, 48, 36, 3));
+    for (algorithm, everywhere, name) in methods() {
+        let job = RenderJob::new(scene.clone(), merging_everywhere(settings(algorithm, 48, 36, 3), everywhere));
         let a = render_blocking_on(&one, &job).unwrap().0;
         let b = render_blocking_on(&two, &job).unwrap().0;
-        assert!(a.pixels == b.pixels, "{algorithm}: one thread and two differ");
-        assert!(a.pixels.iter().flatten().any(|c| *c > 0.0), "{algorithm}: a black image");
+        assert!(a.pixels == b.pixels, "{name}: one thread and two differ");
+        assert!(a.pixels.iter().flatten().any(|c| *c > 0.0), "{name}: a black image");
     }
 }
 
@@ -514,11 +528,8 @@ fn the_caustic_seen_in_a_mirror_needs_merging() {
         pixels.iter().map(|&i| image.pixels[i][1] as f64).sum::<f64>() / pixels.len() as f64
     };
     let sppm_radius = 0.02 * World::for_view(&valid(scene.clone()), &model, w, h).1;
-    let regions = |algorithm: Algorithm, passes: u32, caustics: bool| {
-        let mut s = settings(algorithm, w, h, passes);
-        if caustics {
-            s = caustic_vcm(s);
-        }
+    let regions = |algorithm: Algorithm, passes: u32, everywhere: bool| {
+        let mut s = merging_everywhere(settings(algorithm, w, h, passes), everywhere);
         s.set_photons(50_000);
         if let gi_studio::render::Method::Vcm(m) = &mut s.method {
             m.radius = sppm_radius;
@@ -530,9 +541,9 @@ fn the_caustic_seen_in_a_mirror_needs_merging() {
     let path = regions(Algorithm::Path, 64, false);
     let bdpt = regions(Algorithm::Bdpt, 128, false);
     let vcm = regions(Algorithm::Vcm, 128, false);
-    let caustic_vcm = regions(Algorithm::Vcm, 128, true);
+    let everywhere = regions(Algorithm::Vcm, 128, true);
     println!(
-        "floor, mirror: SPPM {sppm:.3?}, path {path:.3?}, BDPT {bdpt:.3?}, VCM {vcm:.3?}, caustic merges {caustic_vcm:.3?}"
+        "floor, mirror: SPPM {sppm:.3?}, path {path:.3?}, BDPT {bdpt:.3?}, VCM {vcm:.3?}, merging everywhere {everywhere:.3?}"
     );
     assert!(path.0 < 0.15 * sppm.0 && path.1 < 0.15 * sppm.1, "path tracing found a caustic: {path:?}");
     assert!(bdpt.1 < 0.15 * sppm.1, "BDPT found the caustic in the mirror: {bdpt:?}");
@@ -540,14 +551,17 @@ fn the_caustic_seen_in_a_mirror_needs_merging() {
     for (name, floor_mean) in [("BDPT", bdpt.0), ("VCM", vcm.0)] {
         assert!((floor_mean / sppm.0 - 1.0).abs() < 0.10, "{name} {floor_mean} against SPPM's {} on the floor", sppm.0);
     }
-    for (name, mirror_mean) in [("VCM", vcm.1), ("VCM with caustic merges", caustic_vcm.1)] {
+    for (name, mirror_mean) in [("VCM", vcm.1), ("VCM merging everywhere", everywhere.1)] {
         assert!(
             (mirror_mean / sppm.1 - 1.0).abs() < 0.15,
             "in the mirror {name} {mirror_mean} against SPPM's {}",
             sppm.1
         );
     }
-    assert!((caustic_vcm.0 / sppm.0 - 1.0).abs() < 0.10, "caustic merges {caustic_vcm:?} against SPPM's on the floor");
+    assert!(
+        (everywhere.0 / sppm.0 - 1.0).abs() < 0.10,
+        "merging everywhere {everywhere:?} against SPPM's on the floor"
+    );
 }
 
 /// The strategy view holds every strategy's share: with paths of at most
@@ -561,8 +575,8 @@ fn the_strategies_add_up_to_the_image() {
     use gi_studio::render::integrators::bidir::strategies::{Strategy, MAX_LENGTH, SHRINK};
     use gi_studio::render::{Algorithm, RenderEvent, RenderJob, RenderSession, Workers};
     let scene = std::sync::Arc::new(valid(common::detectors::diffuse_cornell()));
-    for algorithm in [Algorithm::LightTracing, Algorithm::Bdpt, Algorithm::Vcm] {
-        let mut s = settings(algorithm, 32, 24, 16);
+    for (algorithm, everywhere, name) in methods().into_iter().filter(|m| m.0 != Algorithm::Bpm) {
+        let mut s = merging_everywhere(settings(algorithm, 32, 24, 16), everywhere);
         s.max_depth = MAX_LENGTH;
         let job = RenderJob { strategies: true, ..RenderJob::new(scene.clone(), s) };
         let session = RenderSession::new(Workers::shared().unwrap(), None).unwrap();
@@ -579,13 +593,13 @@ fn the_strategies_add_up_to_the_image() {
             }
         }
         let (images, image) = (images.expect("strategy images"), image.expect("an image"));
-        assert_eq!(images.passes, 16, "{algorithm}: the view saw the last pass");
+        assert_eq!(images.passes, 16, "{name}: the view saw the last pass");
         let small = image.downsample(SHRINK);
         for (i, pixel) in small.pixels.iter().enumerate() {
             for c in 0..3 {
                 let sum: f64 = images.weighted.iter().map(|cell| cell[i][c] as f64).sum();
                 let want = pixel[c] as f64;
-                assert!((sum - want).abs() <= 1e-4 * want.max(1e-2), "{algorithm}: small pixel {i}: {sum} vs {want}");
+                assert!((sum - want).abs() <= 1e-4 * want.max(1e-2), "{name}: small pixel {i}: {sum} vs {want}");
             }
         }
         if algorithm == Algorithm::Bdpt {

@@ -38,23 +38,23 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("cornell", "lt", 0x9759665f475ad177),
     ("cornell", "bdpt", 0xb3a8252a050a03bd),
     ("cornell", "bpm", 0x5fc2df9477771230),
-    ("cornell", "vcm", 0x1b195b7b4ffa81a9),
+    ("cornell", "vcm", 0xf2ef124c07a298bb),
     ("smallpt", "lt", 0xc809727425375075),
     ("smallpt", "bdpt", 0xeb0bae7dafa5fa4a),
     ("smallpt", "bpm", 0x4846a6e7899f2fd5),
-    ("smallpt", "vcm", 0xe02f1f9239cdf1cd),
+    ("smallpt", "vcm", 0xf0460af83dc55a4a),
     ("thesis", "lt", 0xe36e11464d6dcfb3),
     ("thesis", "bdpt", 0x3357a61768b7f9ed),
     ("thesis", "bpm", 0x2a15eb5b7887fa2a),
-    ("thesis", "vcm", 0x9f84bcc6f49503bf),
+    ("thesis", "vcm", 0x902f4db71801afe8),
     ("lights", "lt", 0xf8ee7f8c4733afeb),
     ("lights", "bdpt", 0x6a93aaf1eb908576),
     ("lights", "bpm", 0x647f0e963c39a43a),
-    ("lights", "vcm", 0xcc21d3d6572bf26f),
+    ("lights", "vcm", 0x6a93aaf1eb908576),
     ("caustics", "lt", 0xf3b6b05f01fd2c0e),
     ("caustics", "bdpt", 0x569cb711ea4843a9),
     ("caustics", "bpm", 0xa7fd24578afde5bb),
-    ("caustics", "vcm", 0xe756637013ee16a0),
+    ("caustics", "vcm", 0x6b00249e06a50adc),
     ("mirror-caustic", "whitted", 0x64dde4973d71bdb1),
     ("mirror-caustic", "path", 0x7ce42b5817d63f7b),
     ("mirror-caustic", "photon", 0x15537020ad47320a),
@@ -62,7 +62,7 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("mirror-caustic", "lt", 0xb4c07f387dca1d23),
     ("mirror-caustic", "bdpt", 0x1e424ad4c5b0981c),
     ("mirror-caustic", "bpm", 0x70f80bee3c80aeb4),
-    ("mirror-caustic", "vcm", 0xa9b3a4fe8e0ceb20),
+    ("mirror-caustic", "vcm", 0x2fabc348549c39ad),
     ("gap-room", "whitted", 0x155e05662ff112c4),
     ("gap-room", "path", 0x47db7c52626d59fc),
     ("gap-room", "photon", 0xf49e6230de64c130),
@@ -70,7 +70,7 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("gap-room", "lt", 0x2acffbfe6536790e),
     ("gap-room", "bdpt", 0xb2a247b586f370f8),
     ("gap-room", "bpm", 0x7766370b40aa03f3),
-    ("gap-room", "vcm", 0x0f638060c83ecbf4),
+    ("gap-room", "vcm", 0xb2a247b586f370f8),
     ("glossy", "whitted", 0x7a1e8bbbd6f2e67e),
     ("glossy", "path", 0xa04258e523f89b5a),
     ("glossy", "photon", 0x9a52f2a39c20266f),
@@ -78,15 +78,15 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("glossy", "lt", 0xf581567eb7216c10),
     ("glossy", "bdpt", 0x74bbf92aa5792038),
     ("glossy", "bpm", 0x35f6f40d372672f9),
-    ("glossy", "vcm", 0x47ef822313a29bba),
-    ("cornell", "vcm+caustic", 0xf2ef124c07a298bb),
-    ("smallpt", "vcm+caustic", 0xf0460af83dc55a4a),
-    ("thesis", "vcm+caustic", 0x902f4db71801afe8),
-    ("lights", "vcm+caustic", 0x6a93aaf1eb908576),
-    ("caustics", "vcm+caustic", 0x6b00249e06a50adc),
-    ("mirror-caustic", "vcm+caustic", 0x2fabc348549c39ad),
-    ("gap-room", "vcm+caustic", 0xb2a247b586f370f8),
-    ("glossy", "vcm+caustic", 0x74bbf92aa5792038),
+    ("glossy", "vcm", 0x74bbf92aa5792038),
+    ("cornell", "vcm+everywhere", 0x1b195b7b4ffa81a9),
+    ("smallpt", "vcm+everywhere", 0xe02f1f9239cdf1cd),
+    ("thesis", "vcm+everywhere", 0x9f84bcc6f49503bf),
+    ("lights", "vcm+everywhere", 0xcc21d3d6572bf26f),
+    ("caustics", "vcm+everywhere", 0xe756637013ee16a0),
+    ("mirror-caustic", "vcm+everywhere", 0xa9b3a4fe8e0ceb20),
+    ("gap-room", "vcm+everywhere", 0x0f638060c83ecbf4),
+    ("glossy", "vcm+everywhere", 0x47ef822313a29bba),
 ];
 
 pub fn image_hash(image: &LinearImage) -> u64 {
@@ -95,7 +95,7 @@ pub fn image_hash(image: &LinearImage) -> u64 {
 }
 
 /// `name` is an algorithm, with `+final-gather` (photon mapping) or
-/// `+caustic` (VCM merging on caustic paths only) after it.
+/// `+everywhere` (VCM merging everywhere, not only on caustic paths) after it.
 fn golden_render(preset: &str, name: &str) -> LinearImage {
     let (algorithm, variant) = name.split_once('+').unwrap_or((name, ""));
     let algorithm = algorithm.parse().unwrap();
@@ -112,7 +112,7 @@ fn golden_render(preset: &str, name: &str) -> LinearImage {
         (p.final_gather, p.final_gather_rays) = (variant == "final-gather", 4);
     }
     if let Method::Vcm(m) = &mut settings.method {
-        m.caustic_merges = variant == "caustic";
+        m.caustic_merges &= variant != "everywhere";
     }
     render_blocking(&RenderJob::new(Arc::new(valid(scene)), settings)).unwrap().0
 }
@@ -130,13 +130,13 @@ fn every_preset_and_algorithm_renders_its_golden_image() {
 }
 
 /// Where no light passes a mirror or glass (lights, gap-room, glossy), VCM
-/// merging on caustic paths only has no merge to make and weighs every
+/// (merging on caustic paths only) has no merge to make and weighs every
 /// connection as BDPT does: its image is BDPT's, bit for bit. A merge's
 /// share left in any connection's weight would darken it.
 #[test]
 fn caustic_merges_without_mirrors_or_glass_are_bdpt() {
     for preset in ["lights", "gap-room", "glossy"] {
-        let (vcm, bdpt) = (golden_render(preset, "vcm+caustic"), golden_render(preset, "bdpt"));
+        let (vcm, bdpt) = (golden_render(preset, "vcm"), golden_render(preset, "bdpt"));
         assert!(vcm.pixels == bdpt.pixels, "{preset}: VCM with caustic merges is not BDPT");
     }
 }

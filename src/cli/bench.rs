@@ -56,7 +56,7 @@ pub struct BenchArgs {
     /// Replace output files that GI Studio did not write.
     #[arg(long)]
     pub force: bool,
-    /// Where VCM merges: caustics or everywhere [default: the settings' default].
+    /// Where VCM merges: caustics or everywhere [default: caustics].
     #[arg(long, value_enum)]
     pub merges: Option<Merges>,
 }

@@ -182,7 +182,7 @@ pub struct BidirFlags {
     /// Merge radius reduction α in (0, 1] (bpm, vcm).
     #[arg(long, value_parser = |s: &str| limits::SPPM_ALPHA.parse(s))]
     pub merge_alpha: Option<f32>,
-    /// Where VCM merges: caustics (only where light came through a mirror or glass; connections make every other path) or everywhere (Georgiev et al. 2012) [default: the settings' default].
+    /// Where VCM merges: caustics (only where light came through a mirror or glass; connections make every other path) or everywhere (Georgiev et al. 2012) [default: caustics].
     #[arg(long, value_enum)]
     pub merges: Option<Merges>,
 }

@@ -29,10 +29,11 @@ pub struct Strategies {
     /// Merges only where light came to the vertex through a mirror or
     /// glass (a caustic path), which no connection can make; every other
     /// path is left to the connections, which make it without the merge's
-    /// blur, and the query for most camera vertices is skipped
-    /// (Grittmann et al., "Efficient Caustic Rendering with Lightweight
-    /// Photon Mapping", 2018). A merge at a vertex is a strategy of the path
-    /// by this rule alone, so the weights still sum to one.
+    /// blur, and most light vertices stay out of the grid. (Lightweight
+    /// photon mapping, Grittmann et al. 2018, likewise keeps photon
+    /// mapping to the paths a path tracer samples badly.) Whether a merge
+    /// at a vertex is a strategy depends on the path alone, so the weights
+    /// still sum to one.
     pub caustic_merges: bool,
     /// Light subpaths per pass (one a pixel).
     pub light_paths: f32,

@@ -11,7 +11,9 @@
 //! - BDPT: every connection, weighed by multiple importance sampling.
 //! - Bidirectional photon mapping: only merges, weighed among themselves.
 //! - VCM: both, the merge radius shrinking as pass^−(1−α)/2, so the image
-//!   converges where a caustic seen in a mirror leaves BDPT nothing.
+//!   converges where a caustic seen in a mirror leaves BDPT nothing. By
+//!   default it merges only where light came through a mirror or glass
+//!   (`Strategies::caustic_merges`); merging everywhere is an option.
 
 pub mod camera_paths;
 pub mod light_paths;
