@@ -84,6 +84,11 @@ pub struct LightPaths {
 #[derive(Default)]
 pub struct PathChunk {
     pub vertices: Vec<LightVertex>,
+    /// How many of them light came to through a mirror or glass (only
+    /// those merge, by default): counted as they are kept, so a grid of
+    /// them knows its size, and passes over a chunk with none, without
+    /// reading a vertex.
+    pub after_specular: u32,
     /// Where each path's vertices end in `vertices` (they start where the
     /// previous path's end).
     ends: Vec<u32>,
@@ -125,7 +130,8 @@ pub fn trace(
     let mut paths =
         LightPaths { chunks: Vec::new(), splats: Vec::new(), contributions: Vec::new(), counters: Counters::default() };
     for chunk in per_chunk? {
-        paths.chunks.push(PathChunk { vertices: chunk.vertices, ends: chunk.ends });
+        let after_specular = chunk.after_specular;
+        paths.chunks.push(PathChunk { vertices: chunk.vertices, after_specular, ends: chunk.ends });
         paths.splats.push(chunk.splats);
         paths.contributions.push(chunk.contributions);
         paths.counters.add(&chunk.counters);
@@ -137,6 +143,8 @@ pub fn trace(
 #[derive(Default)]
 struct ChunkPaths {
     vertices: Vec<LightVertex>,
+    /// Of `vertices`, those light came to through a mirror or glass.
+    after_specular: u32,
     ends: Vec<u32>,
     splats: Vec<Splat>,
     contributions: Vec<Contribution>,
@@ -290,6 +298,7 @@ impl<'w> Flights<'_, 'w> {
             let vertex = LightVertex { hit: hit.surface, wo, bsdf, throughput, length, partials, held, after_specular };
             if ctx.keeps_vertices() {
                 out.vertices.push(vertex);
+                out.after_specular += after_specular as u32;
             }
             if s.connect || ctx.light_tracing {
                 let seen = match drawn {

@@ -62,10 +62,7 @@ impl MergeGrid {
         // The vertices read in sequence here, so that only small records
         // are gathered in the grid's order; each chunk into its own stretch
         let counts: Vec<usize> = (paths.chunks.iter())
-            .map(|chunk| match caustics_only {
-                true => chunk.vertices.iter().filter(keep).count(),
-                false => chunk.vertices.len(),
-            })
+            .map(|chunk| if caustics_only { chunk.after_specular as usize } else { chunk.vertices.len() })
             .collect();
         let count = counts.iter().sum();
         let MergeBuffers { by_vertex: mut merged, by_slot: mut vertices, mut positions } = buffers;
@@ -76,7 +73,8 @@ impl MergeGrid {
         positions.resize(count, Vec3::ZERO);
         let mut stretches = Vec::with_capacity(paths.chunks.len());
         let (mut positions_left, mut merged_left) = (&mut positions[..], &mut merged[..]);
-        for (chunk, &count) in paths.chunks.iter().zip(&counts) {
+        // A chunk with nothing to keep is not read
+        for (chunk, &count) in paths.chunks.iter().zip(&counts).filter(|(_, &count)| count > 0) {
             let (here, rest) = std::mem::take(&mut positions_left).split_at_mut(count);
             let (merged_here, merged_rest) = std::mem::take(&mut merged_left).split_at_mut(count);
             stretches.push((chunk, here, merged_here));
