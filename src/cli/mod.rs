@@ -198,12 +198,12 @@ impl BidirFlags {
             .find_map(|(given, name)| given.then_some(name))
     }
 
-    fn given_caustic(&self) -> Option<&'static str> {
+    fn given_merge_rule(&self) -> Option<&'static str> {
         self.merges.is_some().then_some("--merges")
     }
 
     fn given(&self) -> Option<&'static str> {
-        self.given_mis().or(self.given_merge()).or(self.given_caustic())
+        self.given_mis().or(self.given_merge()).or(self.given_merge_rule())
     }
 
     pub fn apply(&self, m: &mut MergeSettings) {
@@ -233,12 +233,12 @@ impl RenderFlags {
             }
             Method::Bdpt(b) => {
                 b.mis = bidir.mis.unwrap_or(b.mis);
-                photon.given().or(sppm.given()).or(bidir.given_merge()).or(bidir.given_caustic())
+                photon.given().or(sppm.given()).or(bidir.given_merge()).or(bidir.given_merge_rule())
             }
             Method::Bpm(m) => {
                 bidir.apply(m);
                 // Merges are its only strategy
-                photon.given().or(sppm.given()).or(bidir.given_caustic())
+                photon.given().or(sppm.given()).or(bidir.given_merge_rule())
             }
             Method::Vcm(m) => {
                 bidir.apply(m);

@@ -176,9 +176,10 @@ impl Partials {
     /// Leaving a vertex along a direction sampled with density `pdf`, whose
     /// reverse density (sampling the way back) is `reverse_pdf`, at cosine
     /// `cos_out`; `specular` for a delta lobe [report (34)–(36), (53)–(55)].
-    /// A merge at the vertex is counted if `merges_here`; if not, what it
-    /// would have added is returned, for a camera subpath that learns only
-    /// at its next vertex whether the merge is a strategy (`merge_behind`).
+    /// A merge at the vertex is counted if `merges_here`; if not, and merges
+    /// are caustic only, what it would have added is returned, for a camera
+    /// subpath that learns only at its next vertex whether the merge is a
+    /// strategy (`merge_behind`).
     #[inline]
     pub fn scatter(
         &mut self,
@@ -200,7 +201,8 @@ impl Partials {
             self.vc = g * (self.vc * s.mis(reverse_pdf) + self.vcm + vm_weight);
             self.vm = g * (self.vm * s.mis(reverse_pdf) + self.vcm * s.vc_weight + one);
             self.vcm = s.mis64(1.0 / pdf as f64);
-            MergeBehind(if merges_here { 0.0 } else { g })
+            // Only caustic merges are ever counted later
+            MergeBehind(if merges_here || !s.caustic_merges { 0.0 } else { g })
         }
     }
 
