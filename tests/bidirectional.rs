@@ -496,8 +496,9 @@ fn the_same_seed_gives_the_same_image_on_any_number_of_threads() {
 ///   (SPPM's caustic still blurs by its radius: 5% low at 512 passes on a
 ///   larger image; the mirror's region is 11 pixels). VCM merges with
 ///   SPPM's starting radius here, 2% of what the camera sees, so both blur
-///   alike (VCM's own default is a quarter of that: at 128 passes of 64×48
-///   its 11 mirror pixels are too noisy to hold within 15%).
+///   alike (VCM's own defaults are a half of that, merging on caustic
+///   paths, and a quarter, merging everywhere: at 128 passes of 64×48 the
+///   quarter's 11 mirror pixels were too noisy to hold within 15%).
 #[test]
 fn the_caustic_seen_in_a_mirror_needs_merging() {
     use gi_studio::render::Algorithm;

@@ -176,7 +176,7 @@ pub struct BidirFlags {
     /// How strategies are weighed: power or balance (bdpt, bpm, vcm).
     #[arg(long)]
     pub mis: Option<MisHeuristic>,
-    /// Merge radius at the first pass (bpm, vcm; 0 = 2% of what the camera sees for bpm, 0.5% for vcm).
+    /// Merge radius at the first pass (bpm, vcm; 0 = 2% of what the camera sees for bpm, 1% for vcm, 0.5% for vcm merging everywhere).
     #[arg(long, value_parser = |s: &str| limits::LENGTH.parse(s))]
     pub merge_radius: Option<f32>,
     /// Merge radius reduction α in (0, 1] (bpm, vcm).

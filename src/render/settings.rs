@@ -190,8 +190,8 @@ pub struct BidirSettings {
 
 /// Vertex merging (bidirectional photon mapping, and VCM's merges): the
 /// merge radius at the first pass (0: 2% of what the camera sees for BPM,
-/// 0.5% for VCM), which
-/// shrinks as pass^−(1−α)/2.
+/// 1% for VCM merging on caustic paths, 0.5% for VCM merging everywhere),
+/// which shrinks as pass^−(1−α)/2.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct MergeSettings {
