@@ -591,7 +591,7 @@ mod tests {
                 };
                 let scalar_ctx = Context { path_lanes: None, ..lanes_ctx };
                 let paths = light_paths::trace(&lanes_ctx, pixels as u64, 2, 5, &|| true).expect("not cancelled");
-                let grid = MergeGrid::build(&paths, radius, caustics, Default::default());
+                let grid = MergeGrid::build(&paths, radius, &lanes_ctx.strategies, Default::default());
                 let light = LightSide { paths: &paths, grid: Some(&grid), radius };
                 // A tile that does not split into eights, away from the corner
                 let rect = TileRect { x: 3, y: 5, width: 29, height: 11 };

@@ -9,7 +9,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::light_paths::{LightPaths, LightVertex};
-use super::mis::Partials;
+use super::mis::{Partials, Strategies};
 use crate::render::integrators::photon_map::cells::PointGrid;
 use crate::scene::Rgb;
 
@@ -55,14 +55,18 @@ pub struct MergeBuffers {
 
 impl MergeGrid {
     /// The grid of `paths`' vertices for merges within `radius` (cells
-    /// `MERGE_CELLS` radii wide), in `buffers`; with `caustics_only`, only
-    /// the vertices light came to through a mirror or glass.
-    pub fn build(paths: &LightPaths, radius: f32, caustics_only: bool, buffers: MergeBuffers) -> Self {
-        let keep = |v: &&LightVertex| !caustics_only || v.after_specular;
+    /// `MERGE_CELLS` radii wide), in `buffers`: those where `strategies`
+    /// merge (`Strategies::merges_at`).
+    pub fn build(paths: &LightPaths, radius: f32, strategies: &Strategies, buffers: MergeBuffers) -> Self {
+        let keep = |v: &&LightVertex| strategies.merges_at(v.after_specular);
         // The vertices read in sequence here, so that only small records
-        // are gathered in the grid's order; each chunk into its own stretch
+        // are gathered in the grid's order; each chunk into its own stretch.
+        // Each chunk counted its vertices that came through a specular one
         let counts: Vec<usize> = (paths.chunks.iter())
-            .map(|chunk| if caustics_only { chunk.after_specular as usize } else { chunk.vertices.len() })
+            .map(|chunk| match strategies.caustic_merges {
+                true => chunk.after_specular as usize,
+                false => chunk.vertices.len(),
+            })
             .collect();
         let count = counts.iter().sum();
         let MergeBuffers { by_vertex: mut merged, by_slot: mut vertices, mut positions } = buffers;
@@ -120,7 +124,6 @@ impl MergeGrid {
 mod tests {
     use super::*;
     use crate::render::integrators::bidir::light_paths;
-    use crate::render::integrators::bidir::mis::Strategies;
     use crate::render::integrators::bidir::Context;
     use crate::render::integrators::photon_map::emit::LightPicker;
     use crate::render::settings::MisHeuristic;
@@ -163,10 +166,11 @@ mod tests {
             grid.for_each_within(v.hit.point, radius, |m| found |= m.wo == v.wo && m.length == v.length);
             found
         };
-        let full = MergeGrid::build(&paths, radius, false, MergeBuffers::default());
+        let everywhere = Strategies::new(MisHeuristic::Power, true, true, pixels, radius);
+        let full = MergeGrid::build(&paths, radius, &everywhere, MergeBuffers::default());
         assert_eq!(full.points.len(), vertices.len());
         assert!(vertices.iter().all(|v| found(&full, v)));
-        let caustics = MergeGrid::build(&paths, radius, true, full.into_buffers());
+        let caustics = MergeGrid::build(&paths, radius, &ctx.strategies, full.into_buffers());
         assert_eq!(caustics.points.len(), caustic.len());
         assert!(vertices.iter().all(|v| found(&caustics, v) == v.after_specular));
     }

@@ -203,9 +203,9 @@ impl Bidir {
         let keep_going = || observer.is_current();
         let paths = light_paths::trace(&ctx, pixels, pass as u64, self.seed, &keep_going)?;
         let radius = self.merge_radius(pass);
-        let grid = weighing.merge.then(|| {
-            MergeGrid::build(&paths, radius, weighing.caustic_merges, std::mem::take(&mut self.merge_buffers))
-        });
+        let grid = weighing
+            .merge
+            .then(|| MergeGrid::build(&paths, radius, &weighing, std::mem::take(&mut self.merge_buffers)));
         if !observer.is_current() {
             return None;
         }
