@@ -200,6 +200,31 @@ fn a_render_that_never_ends_does_not_hold_back_another_on_the_same_workers() {
     drop(endless);
 }
 
+/// Two panes on one pool: each pane's clock counts only its own stages, so
+/// the two clocks add up to no more than the time both renders took
+/// together. Sharing the threads at once, each clock would count the
+/// other's work too, and they would add up to nearly twice that.
+#[test]
+fn each_session_counts_only_its_own_time_on_shared_workers() {
+    let workers = Workers::new(2).unwrap();
+    let sessions = [RenderSession::new(&workers, None).unwrap(), RenderSession::new(&workers, None).unwrap()];
+    let start = std::time::Instant::now();
+    let generations = sessions.each_ref().map(|session| session.start(job("cornell", Algorithm::Path, 96, 72, 24)));
+    let times = [0, 1].map(|i| loop {
+        // A hang guard, not a timing test
+        match sessions[i].events().recv_timeout(Duration::from_secs(120)) {
+            Ok(RenderEvent::Finished { generation, stats, .. }) if generation == generations[i] => {
+                assert_eq!(stats.passes, 24);
+                break stats.elapsed;
+            }
+            Ok(_) => {}
+            Err(_) => panic!("render {i} never finished"),
+        }
+    });
+    let whole = start.elapsed();
+    assert!(times[0] + times[1] <= whole, "the panes' times {times:?} add up to more than the {whole:?} both took");
+}
+
 /// A driver that abandons its job at its `after`-th tile and counts the
 /// tiles still finished after that: the work a cancel waits for.
 struct Abandoning {

@@ -70,6 +70,11 @@ pub fn viewport_ui(
     let label_rect = egui::Rect::from_min_size(rect.min, galley.size() + egui::vec2(12.0, 6.0));
     ui.painter().rect_filled(label_rect, 3.0, egui::Color32::from_black_alpha(160));
     ui.painter().galley(rect.min + egui::vec2(6.0, 3.0), galley, egui::Color32::WHITE);
+    ui.interact(label_rect, response.id.with("label"), egui::Sense::hover()).on_hover_text(
+        "Seconds are the pane's own: the time its passes took on the render threads. \
+         Panes take turns on the threads, fairly by time, so a pane's clock, samples per second \
+         and error curve do not depend on how many panes render beside it.",
+    );
     if let Some(message) = &pane.state().failed {
         ui.painter().text(
             rect.center(),

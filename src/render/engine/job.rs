@@ -5,13 +5,13 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::Duration;
 
 use crossbeam_channel::Sender;
 use rayon::prelude::*;
 
 use super::events::{Notify, PassStats, RenderEvent, TileUpdate};
-use super::workers::Workers;
+use super::workers::{Share, Workers};
 use crate::faults::{self, Fault};
 use crate::render::film::Film;
 use crate::render::integrators::bidir::strategies::StrategyImages;
@@ -117,10 +117,10 @@ impl PassObserver for JobContext<'_> {
 }
 
 /// Render `job` on `workers`. Each stage (preparing, the preview, every
-/// pass) is handed to the pool on its own: the pool is shared, and a thread
-/// waiting inside one job's parallel loop may pick up another's queued
-/// stage, so a stage is all another job ever waits for; a whole render
-/// handed over at once could hold a pane behind a 4096-pass reference.
+/// pass) takes its turn on the shared pool on its own, so a stage is all
+/// another job ever waits for (a whole render handed over at once could
+/// hold a pane behind a 4096-pass reference), and the job's time is the
+/// sum of its stages' times: its own work, not its waiting.
 pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) {
     let settings = &job.settings;
     let generation = context.generation;
@@ -131,13 +131,17 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
     let camera = CameraModel::new(&job.scene.camera, settings.width, settings.height);
     let (world, visible_radius) = World::for_view(&job.scene, &camera, settings.width, settings.height);
     let stage = Stage { world: &world, camera: &camera, settings };
-    let start = Instant::now();
+    // The job's own time: its stages' times on the pool, not the time they
+    // waited for other sessions' stages
+    let mut busy = Duration::ZERO;
+    let mut share = Share::default();
     let halves = settings.algorithm().is_unbiased();
     let mut film = Film::new(settings.width, settings.height, settings.tile_size, halves);
-    let prepared = workers.run(|| {
+    let (prepared, took) = workers.run_in_turn(&mut share, || {
         assert!(!faults::active(Fault::RenderPanics), "an injected bug");
         Integrator::prepare(&stage, &film, visible_radius, job.photon_maps.clone(), context)
     });
+    busy += took;
     let Some(mut integrator) = prepared else {
         return;
     };
@@ -147,36 +151,38 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
     context.send(RenderEvent::Started { generation, width: settings.width, height: settings.height });
 
     if settings.preview {
-        workers.run(|| {
-            film.tiles.par_iter().with_max_len(1).for_each(|tile| {
-                if context.is_current() {
-                    let pixels = integrator.preview_tile(&stage, tile.rect);
-                    let update = TileUpdate { generation, rect: tile.rect, pixels, preview: true, variance: None };
-                    context.send(RenderEvent::Tile(update));
-                }
+        busy += workers
+            .run_in_turn(&mut share, || {
+                film.tiles.par_iter().with_max_len(1).for_each(|tile| {
+                    if context.is_current() {
+                        let pixels = integrator.preview_tile(&stage, tile.rect);
+                        let update = TileUpdate { generation, rect: tile.rect, pixels, preview: true, variance: None };
+                        context.send(RenderEvent::Tile(update));
+                    }
+                })
             })
-        });
+            .1;
     }
 
     let mut stats = PassStats::default();
     loop {
         let done_spp = settings.samples_per_pixel.is_some_and(|spp| stats.passes >= spp);
-        let done_time =
-            settings.time_limit.is_some_and(|limit| stats.passes > 0 && start.elapsed().as_secs_f64() >= limit);
+        let done_time = settings.time_limit.is_some_and(|limit| stats.passes > 0 && busy.as_secs_f64() >= limit);
         if done_spp || done_time {
             break;
         }
-        let pass_start = Instant::now();
         let pass = settings.first_pass + stats.passes;
-        let Some(report) = workers.run(|| integrator.pass(&stage, &mut film, pass, context)) else {
+        let (report, pass_time) = workers.run_in_turn(&mut share, || integrator.pass(&stage, &mut film, pass, context));
+        let Some(report) = report else {
             return;
         };
+        busy += pass_time;
         stats.rays += report.counters.rays;
         stats.non_finite += report.counters.non_finite;
         stats.passes += 1;
         stats.samples += settings.width as u64 * settings.height as u64;
-        stats.pass_time = pass_start.elapsed();
-        stats.elapsed = start.elapsed();
+        stats.pass_time = pass_time;
+        stats.elapsed = busy;
         stats.photon = report.photon;
         stats.paths = report.paths;
         stats.noise = report.noise.estimate().or(stats.noise);
