@@ -2,7 +2,7 @@
 //! against time on log–log axes, and the photon maps' statistics.
 
 use eframe::egui;
-use egui_plot::{Bar, BarChart, HLine, Legend, Line, LineStyle, Plot};
+use egui_plot::{Bar, BarChart, Corner, HLine, Legend, Line, LineStyle, Plot};
 
 use super::pane::{Pane, PaneError};
 use crate::render::integrators::photon_map::maps::RADIUS_BINS;
@@ -17,7 +17,7 @@ pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
             for (i, pane) in panes.iter().enumerate() {
                 let points: Vec<[f64; 2]> =
                     pane.state().history.iter().map(|r| [r.passes as f64, r.pass_seconds * 1e3]).collect();
-                plot.line(Line::new(series_name(i, pane), points));
+                plot.line(pane_line(i, pane, points));
             }
         });
         columns[1].label("Samples per second (M) over time (s)");
@@ -25,11 +25,13 @@ pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
             for (i, pane) in panes.iter().enumerate() {
                 let points: Vec<[f64; 2]> =
                     pane.state().history.iter().map(|r| [r.seconds, r.samples_per_second / 1e6]).collect();
-                plot.line(Line::new(series_name(i, pane), points));
+                plot.line(pane_line(i, pane, points));
             }
         });
         columns[2].label("log₁₀ relMSE against log₁₀ seconds (dashed: estimated from own noise)");
-        Plot::new("error").legend(Legend::default()).height(height).show(&mut columns[2], |plot| {
+        // Errors fall as time goes on: the lower left is where no curve is
+        let legend = Legend::default().position(Corner::LeftBottom);
+        Plot::new("error").legend(legend).height(height).show(&mut columns[2], |plot| {
             let mut floor = None;
             for (i, pane) in panes.iter().enumerate() {
                 let (mut line, mut low, mut high, mut estimated) = (Vec::new(), Vec::new(), Vec::new(), false);
@@ -46,22 +48,36 @@ pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
                         PaneError::Estimated(_) => estimated = true,
                     }
                 }
-                let name = series_name(i, pane);
                 let style = if estimated { LineStyle::dashed_loose() } else { LineStyle::Solid };
-                plot.line(Line::new(name.clone(), line).style(style));
-                plot.line(Line::new(name.clone(), low).width(0.5));
-                plot.line(Line::new(name, high).width(0.5));
+                plot.line(pane_line(i, pane, line).style(style));
+                plot.line(pane_line(i, pane, low).width(0.5));
+                plot.line(pane_line(i, pane, high).width(0.5));
             }
             if let Some(floor) = floor.filter(|f| *f > 0.0) {
-                plot.hline(HLine::new("reference's own noise", floor.log10()).style(LineStyle::dotted_dense()));
+                let line = HLine::new("reference's own noise", floor.log10()).color(NOISE_FLOOR_COLOR);
+                plot.hline(line.style(LineStyle::dotted_dense()));
             }
         });
         photons_and_paths_ui(&mut columns[3], panes, height);
     });
 }
 
-fn series_name(index: usize, pane: &Pane) -> String {
-    format!("{} {}", index + 1, pane.algorithm().name())
+/// Pane `index`'s line through `points`, named and coloured as the pane in
+/// every plot: a pane's several lines (the error and its ±1 standard
+/// error) share its colour, and the legend shows it.
+fn pane_line(index: usize, pane: &Pane, points: Vec<[f64; 2]>) -> Line<'static> {
+    let name = format!("{} {}", index + 1, pane.algorithm().name());
+    Line::new(name, points).color(pane_color(index))
+}
+
+/// Grey: no pane's colour.
+const NOISE_FLOOR_COLOR: egui::Color32 = egui::Color32::GRAY;
+
+/// egui_plot's own sequence of colours (what it gives the `index`th line
+/// left to choose), so panes keep the colours they had.
+fn pane_color(index: usize) -> egui::Color32 {
+    let golden_ratio = (5.0_f32.sqrt() - 1.0) / 2.0;
+    egui::ecolor::Hsva::new(index as f32 * golden_ratio, 0.85, 0.5, 1.0).into()
 }
 
 fn photons_and_paths_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
@@ -131,7 +147,7 @@ fn photons_and_paths_ui(ui: &mut egui::Ui, panes: &[Pane], height: f32) {
         ui.small("SPPM mean radius per pass");
         Plot::new("sppm_radius").height(height * 0.5).show(ui, |plot| {
             for (i, points) in radii {
-                plot.line(Line::new(series_name(i, &panes[i]), points));
+                plot.line(pane_line(i, &panes[i], points));
             }
         });
     }
@@ -174,4 +190,21 @@ fn sppm_times_ui(ui: &mut egui::Ui, index: usize, times: &SppmTimes, height: f32
             plot.bar_chart(BarChart::new(*stage, vec![bar]));
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn four_panes_have_four_colours_none_of_them_the_noise_floors() {
+        let colours: Vec<_> = (0..4).map(pane_color).collect();
+        for (i, a) in colours.iter().enumerate() {
+            assert_ne!(*a, NOISE_FLOOR_COLOR);
+            for b in &colours[i + 1..] {
+                let distance: i32 = (0..3).map(|c| (a[c] as i32 - b[c] as i32).abs()).sum();
+                assert!(distance > 60, "panes' colours {a:?} and {b:?} are too close to tell apart");
+            }
+        }
+    }
 }
