@@ -24,8 +24,13 @@ impl ConvergenceLog {
         self.points.push(point);
     }
 
-    /// relMSE of the last point at or before `seconds`.
+    /// relMSE of the last point at or before `seconds`; none if the run
+    /// ended before `seconds` (a 2-s run has no error at 4 s, whatever it
+    /// had when it stopped).
     pub fn error_at(&self, seconds: f64) -> Option<f64> {
+        if self.points.last().is_none_or(|last| last.seconds < seconds) {
+            return None;
+        }
         self.points.iter().take_while(|p| p.seconds <= seconds).last().map(|p| p.error.rel_mse)
     }
 
@@ -88,6 +93,9 @@ mod tests {
         assert_eq!(log.time_to_reach(1e-6), None);
         assert_eq!(log.error_at(0.1), None);
         assert_eq!(log.time_to_stay_within(0.01), Some(10.0));
+        // The curve ends at 16 s
+        assert_eq!(log.error_at(16.0), Some(0.1 / 16.0));
+        assert_eq!(log.error_at(16.5), None, "no error after the run ended");
     }
 
     /// A curve that dips to 0.1 at 1 s, rises, comes back at 4 s and
