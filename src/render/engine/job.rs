@@ -136,10 +136,13 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
     let mut busy = Duration::ZERO;
     let mut share = Share::default();
     let halves = settings.algorithm().is_unbiased();
-    let mut film = Film::new(settings.width, settings.height, settings.tile_size, halves);
-    let (prepared, took) = workers.run_in_turn(&mut share, || {
+    // The film is made in the job's time: its sums are written as it is
+    // made (`Film::new`), which the first pass did before
+    let ((mut film, prepared), took) = workers.run_in_turn(&mut share, || {
         assert!(!faults::active(Fault::RenderPanics), "an injected bug");
-        Integrator::prepare(&stage, &film, visible_radius, job.photon_maps.clone(), context)
+        let film = Film::new(settings.width, settings.height, settings.tile_size, halves);
+        let prepared = Integrator::prepare(&stage, &film, visible_radius, job.photon_maps.clone(), context);
+        (film, prepared)
     });
     busy += took;
     let Some(mut integrator) = prepared else {
