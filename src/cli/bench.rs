@@ -266,9 +266,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             bar.finish_and_clear();
             for p in &run.log.points {
                 let flip = p.flip.map_or(String::new(), |f| format!("{f:.5}"));
+                // Seconds to the last bit: which passes were measured for
+                // FLIP follows from them, rounded it could not be told
                 writeln!(
                     csv,
-                    "{name},{algorithm},{:.4},{},{},{:.6e},{:.2e},{flip}",
+                    "{name},{algorithm},{},{},{},{:.6e},{:.2e},{flip}",
                     p.seconds, p.samples_per_pixel, p.rays, p.error.rel_mse, p.error.standard_error
                 )?;
             }
