@@ -52,7 +52,7 @@ fn assert_lanes_match_scalar(scene: &Scene, max_depth: u32, passes: u64) -> usiz
                 .collect();
             let mut got = vec![Rgb::splat(-1.0); tile.len()];
             let mut lane_counters = Counters::default();
-            lanes.radiance(&world, &tile, max_depth, &mut got, &mut lane_counters);
+            lanes.radiance(&world, &tile, max_depth, &mut |i, v| got[i] = v, &mut lane_counters);
             for (i, (e, g)) in expected.iter().zip(&got).enumerate() {
                 let bits = |v: &Rgb| v.to_array().map(f32::to_bits);
                 assert_eq!(bits(e), bits(g), "sample {i} of {rect:?}, pass {pass}: scalar {e} vs lanes {g}");

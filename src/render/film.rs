@@ -100,6 +100,30 @@ fn written_zeros(n: usize) -> Vec<[f64; 3]> {
     sums
 }
 
+/// Where one pass adds to a tile: every pass's sums, and on an odd pass
+/// the odd passes' too, where the film keeps halves (`FilmTile::pass_sums`).
+pub struct PassSums<'a> {
+    sums: &'a mut [[f64; 3]],
+    odd_sums: Option<&'a mut [[f64; 3]]>,
+}
+
+impl PassSums<'_> {
+    #[inline]
+    pub fn add(&mut self, i: usize, value: Rgb) {
+        add_to(&mut self.sums[i], value);
+        if let Some(odd_sums) = &mut self.odd_sums {
+            add_to(&mut odd_sums[i], value);
+        }
+    }
+}
+
+#[inline]
+fn add_to(sum: &mut [f64; 3], value: Rgb) {
+    for c in 0..3 {
+        sum[c] += value[c] as f64;
+    }
+}
+
 impl FilmTile {
     pub fn new(rect: TileRect, halves: bool) -> Self {
         let odd_sums = if halves { written_zeros(rect.pixels()) } else { Vec::new() };
@@ -116,16 +140,14 @@ impl FilmTile {
     /// tile, in the pass that `samples` is about to count.
     #[inline]
     pub fn add(&mut self, i: usize, value: Rgb) {
-        let sum = &mut self.sums[i];
-        for c in 0..3 {
-            sum[c] += value[c] as f64;
-        }
-        if self.samples % 2 == 1 && !self.odd_sums.is_empty() {
-            let odd = &mut self.odd_sums[i];
-            for c in 0..3 {
-                odd[c] += value[c] as f64;
-            }
-        }
+        self.pass_sums().add(i, value);
+    }
+
+    /// Where the pass that `samples` is about to count adds, pixel by pixel.
+    #[inline]
+    pub fn pass_sums(&mut self) -> PassSums<'_> {
+        let odd = self.samples % 2 == 1 && !self.odd_sums.is_empty();
+        PassSums { sums: &mut self.sums, odd_sums: odd.then_some(&mut self.odd_sums) }
     }
 
     /// Each pixel's (mean, estimated variance of the mean), channel by

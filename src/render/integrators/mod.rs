@@ -286,16 +286,17 @@ impl Integrator {
 
     fn render_tile(&self, stage: &Stage, tile: &mut FilmTile, streams: PassStreams, counters: &mut Counters) {
         let camera_tile = CameraTile { camera: stage.camera, rect: tile.rect, streams };
-        let mut values = vec![Rgb::ZERO; tile.sums.len()];
+        let mut rejected = Counters::default();
+        let mut pass = tile.pass_sums();
+        // Each sample accepted and added as the integrator hands it out
+        let mut add = |i: usize, value: Rgb| pass.add(i, stage.accept(value, &mut rejected).unwrap_or(Rgb::ZERO));
         match self {
-            Integrator::Whitted(whitted) => whitted.render_tile(stage, &camera_tile, &mut values, counters),
-            Integrator::Path(path) => path.render_tile(stage, &camera_tile, &mut values, counters),
-            Integrator::Photon(photon) => photon.render_tile(stage, &camera_tile, &mut values, counters),
+            Integrator::Whitted(whitted) => whitted.render_tile(stage, &camera_tile, &mut add, counters),
+            Integrator::Path(path) => path.render_tile(stage, &camera_tile, &mut add, counters),
+            Integrator::Photon(photon) => photon.render_tile(stage, &camera_tile, &mut add, counters),
             Integrator::Sppm(_) | Integrator::Bidir(_) => unreachable!("they render their own passes"),
         }
-        for (i, value) in values.into_iter().enumerate() {
-            tile.add(i, stage.accept(value, counters).unwrap_or(Rgb::ZERO));
-        }
+        counters.add(&rejected);
         tile.samples += 1;
     }
 

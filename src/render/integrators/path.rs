@@ -37,14 +37,21 @@ impl PathTracer {
         radiance(world, ray, self.max_depth, sampler, counters)
     }
 
-    /// One sample of every pixel of `tile`, into `out`.
-    pub fn render_tile(&self, stage: &Stage, tile: &CameraTile, out: &mut [Rgb], counters: &mut Counters) {
+    /// One sample of every pixel of `tile`, each handed to `out` with its
+    /// index as it is done (`PathLanes::radiance`).
+    pub fn render_tile(
+        &self,
+        stage: &Stage,
+        tile: &CameraTile,
+        out: &mut impl FnMut(usize, Rgb),
+        counters: &mut Counters,
+    ) {
         if let Some(lanes) = &self.lanes {
             return lanes.radiance(stage.world, tile, self.max_depth, out, counters);
         }
-        for (i, value) in out.iter_mut().enumerate() {
+        for i in 0..tile.len() {
             let (ray, mut sampler) = tile.sample(i);
-            *value = self.radiance(stage.world, &ray, &mut sampler, counters);
+            out(i, self.radiance(stage.world, &ray, &mut sampler, counters));
         }
     }
 }

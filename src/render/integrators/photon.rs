@@ -69,16 +69,22 @@ impl PhotonMapping {
         self.renderer(PathScope::new(world, ray.origin)).radiance(ray, sampler, counters, scratch)
     }
 
-    /// One sample of every pixel of `tile`, into `out`: `radiance` of each,
-    /// bit for bit, the camera rays eight at a time and the shadow rays of
-    /// every landing's direct light traced together.
-    pub fn render_tile(&self, stage: &Stage, tile: &CameraTile, out: &mut [Rgb], counters: &mut Counters) {
+    /// One sample of every pixel of `tile`, each handed to `out` with its
+    /// index: `radiance` of each, bit for bit, the camera rays eight at a
+    /// time and the shadow rays of every landing's direct light traced together.
+    pub fn render_tile(
+        &self,
+        stage: &Stage,
+        tile: &CameraTile,
+        out: &mut impl FnMut(usize, Rgb),
+        counters: &mut Counters,
+    ) {
         let (world, lanes) = (stage.world, self.lanes.as_deref());
         let mut scratch = self.scratch();
         let (mut shadows, mut terms) = (ShadowBatch::default(), Vec::new());
         // Each sample's light on the way, and at its landing the throughput,
         // the direct light's terms and the estimates added after them
-        let mut found = vec![(Rgb::ZERO, None); out.len()];
+        let mut found = vec![(Rgb::ZERO, None); tile.len()];
         let land = |i: usize, scope: &PathScope, sampler: &mut Sampler, radiance, landing, counters: &mut Counters| {
             let Some(Landing { hit, wo, bsdf, throughput }) = landing else {
                 found[i] = (radiance, None);
@@ -92,8 +98,8 @@ impl PhotonMapping {
         };
         follow_specular_tile(world, lanes, tile, self.max_depth, counters, land);
         shadows.trace(lanes, world);
-        for (value, (radiance, landed)) in out.iter_mut().zip(found) {
-            *value = match landed {
+        for (i, (radiance, landed)) in found.into_iter().enumerate() {
+            let value = match landed {
                 Some((throughput, lit, caustic, second)) => {
                     let mut shade = lit_sum(&terms[lit], &shadows) + caustic;
                     shade += second;
@@ -101,6 +107,7 @@ impl PhotonMapping {
                 }
                 None => radiance,
             };
+            out(i, value);
         }
         counters.queries.add(&scratch.queries);
     }
@@ -306,7 +313,7 @@ mod tests {
                     };
                     let renderer = if lanes { &photon } else { &scalar };
                     let (mut out, mut counters) = (vec![Rgb::splat(-1.0); tile.len()], Counters::default());
-                    renderer.render_tile(&stage, &tile, &mut out, &mut counters);
+                    renderer.render_tile(&stage, &tile, &mut |i, v| out[i] = v, &mut counters);
                     let got: Vec<[u32; 3]> = out.iter().map(|v| v.to_array().map(f32::to_bits)).collect();
                     let what = format!("{name}, final gather {final_gather}, lanes {lanes}");
                     assert!(got == expected, "{what}: the light differs");

@@ -42,9 +42,18 @@ impl Whitted {
         radiance(world, ray, self.max_depth, sampler, counters)
     }
 
-    /// One sample of every pixel of `tile`, into `out`.
-    pub fn render_tile(&self, stage: &Stage, tile: &CameraTile, out: &mut [Rgb], counters: &mut Counters) {
-        waves::render_tile(stage.world, self.lanes.as_deref(), tile, self.max_depth, out, counters);
+    /// One sample of every pixel of `tile`, each handed to `out` with its
+    /// index once the tile is done (its waves add to every pixel).
+    pub fn render_tile(
+        &self,
+        stage: &Stage,
+        tile: &CameraTile,
+        out: &mut impl FnMut(usize, Rgb),
+        counters: &mut Counters,
+    ) {
+        let mut values = vec![Rgb::ZERO; tile.len()];
+        waves::render_tile(stage.world, self.lanes.as_deref(), tile, self.max_depth, &mut values, counters);
+        values.into_iter().enumerate().for_each(|(i, value)| out(i, value));
     }
 }
 
