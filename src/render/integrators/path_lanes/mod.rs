@@ -354,10 +354,10 @@ impl PathLanes {
     }
 
     /// The radiance of every camera sample of `tile`, each handed to `out`
-    /// (with its index) as its path ends: added to the film there and then,
-    /// its pixel's sums are fetched while other paths go on, where a pass
-    /// over an array of samples after the tile waited on every cache line
-    /// (3% of smallpt's time).
+    /// with its index as its path ends. The film adds it there and then, so
+    /// fetching the pixel's sums overlaps the other lanes' work (a pass over
+    /// an array of samples after the tile waited on each cache line: 3% of
+    /// smallpt's time).
     pub fn radiance(
         &self,
         world: &World,
