@@ -21,6 +21,7 @@ mod lights;
 mod samples;
 mod scatter;
 mod surface_table;
+mod wall_exits;
 
 pub(crate) use draws::{Given, PickedLight, Want};
 pub(crate) use lights::EmittedLanes;
@@ -28,10 +29,11 @@ use lights::{LaneLights, LightLanes};
 use samples::CameraSamples;
 pub(crate) use scatter::{LaneSurfaces, Scattered};
 use surface_table::SurfaceTable;
+use wall_exits::WallExits;
 
 use super::Counters;
 use crate::faults::{self, Fault};
-use crate::geometry::sphere::{nearest_root, wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
+use crate::geometry::sphere::{nearest_root, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_finish_of, watertight_range_of, RayShear};
 use crate::geometry::{gamma, intersect_triangle, offset_origin, Ray, SurfaceHit, Triangle};
 use crate::geometry::{plane_exit_of, plane_point_of, plane_t_of, Crossing, CullEdges, CullPlane};
@@ -175,6 +177,8 @@ pub struct PathLanes {
     /// The light plane of the triangle each light lies on, if any.
     light_planes: Vec<Option<u32>>,
     background: Rgb,
+    /// The walls, as held rays ask where they leave.
+    wall_exits: WallExits,
 }
 
 impl PathLanes {
@@ -279,6 +283,7 @@ impl PathLanes {
             light_spheres,
             light_planes,
             background: world.background,
+            wall_exits: WallExits::new(&world.walls.wall_spheres),
         })
     }
 
@@ -607,18 +612,7 @@ impl PathLanes {
         // The walls' ways out for held paths, after every other sphere:
         // a tie with one goes to the other sphere, as in `World::intersect_held`
         if held.any() {
-            let mut k = F8::splat(0.0);
-            for sphere in &self.spheres {
-                if let Some(wall) = sphere.wall {
-                    let (anchor, normal, radius) =
-                        (V8::splat(wall.anchor), V8::splat(wall.normal), F8::splat(wall.radius));
-                    let (t, exits) = wall_exit(origin, direction, anchor, normal, radius, t_hit);
-                    let closer = exits.and(held);
-                    t_hit = closer.select(t, t_hit);
-                    index = closer.select(k, index);
-                }
-                k = k + 1.0;
-            }
+            self.wall_exits.leave(held, origin, direction, &mut t_hit, &mut index);
         }
         // Planes: in index order for paths not held (`World::intersect`);
         // for held ones the planes that are not walls, then the walls'

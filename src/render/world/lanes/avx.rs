@@ -164,6 +164,13 @@ impl F8 {
         Index8(unsafe { _mm256_cvttps_epi32(self.0) })
     }
 
+    /// `table[index]` lane by lane for indices in 0..8: one permute
+    /// (other indices read by their low three bits).
+    #[inline(always)]
+    pub fn picked(table: F8, index: Index8) -> F8 {
+        F8(unsafe { _mm256_permutevar8x32_ps(table.0, index.0) })
+    }
+
     /// `table[index]` lane by lane for indices in 0..16, `low` holding the
     /// table's first eight values and `high` the rest: two permutes and a
     /// blend (other indices give one of the sixteen).
@@ -480,6 +487,13 @@ impl Count8 {
 }
 
 impl Index8 {
+    /// `first` in the lanes `second` leaves clear, `first + 1` where it is
+    /// set (a set lane is −1 as an integer).
+    #[inline(always)]
+    pub fn of_pair(first: i32, second: M8) -> Self {
+        Index8(unsafe { _mm256_sub_epi32(_mm256_set1_epi32(first), _mm256_castps_si256(second.0)) })
+    }
+
     #[inline(always)]
     pub fn to_array(self) -> [i32; LANES] {
         let mut out = [0; LANES];

@@ -485,6 +485,7 @@ mod tests {
             let (index, p_index) = (whole.to_index(), p_whole.to_index());
             assert_eq!(index.to_array(), p_index.to_array());
             same(F8::permuted(fa, fb, index), p::F8::permuted(pa, pb, p_index), "permuted");
+            same(F8::picked(fa, index), p::F8::picked(pa, p_index), "picked");
             let small = F8::from_fn(|i| (a[i].to_bits() % 24) as f32 - 2.0).to_index();
             let p_small = p::F8::from_array(std::array::from_fn(|i| (a[i].to_bits() % 24) as f32 - 2.0)).to_index();
             same(F8::permuted(fa, fb, small), p::F8::permuted(pa, pb, p_small), "permuted");
@@ -530,6 +531,10 @@ mod tests {
                 assert_eq!(count.ge(bound).to_array(), p_count.ge(bound).to_array());
             }
             let (m, pm) = (fa.lt(fb), pa.lt(pb));
+            let first = (start % 7) as i32 - 2;
+            let pair = Index8::of_pair(first, m).to_array();
+            assert_eq!(pair, p::Index8::of_pair(first, pm).to_array());
+            assert_eq!(pair, m.to_array().map(|set| first + (set != 0) as i32), "of_pair");
             assert_eq!(count.count_in(m).to_array(), p_count.count_in(pm).to_array());
             assert_eq!(count.reset(m).to_array(), p_count.reset(pm).to_array());
             assert_eq!(M8::from_bits(m.bits()), m);

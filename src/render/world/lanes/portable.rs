@@ -141,6 +141,13 @@ impl F8 {
         Index8(self.truncate())
     }
 
+    /// `table[index]` lane by lane for indices in 0..8 (other indices read
+    /// by their low three bits, as the AVX2 permute reads them).
+    #[inline(always)]
+    pub fn picked(table: F8, index: Index8) -> F8 {
+        F8(from_fn(|i| table.0[(index.0[i] & 7) as usize]))
+    }
+
     /// `table[index]` lane by lane for indices in 0..16, `low` holding the
     /// table's first eight values and `high` the rest (other indices read
     /// as the AVX2 permutes read them).
@@ -273,6 +280,12 @@ impl Not for M8 {
 }
 
 impl Index8 {
+    /// `first` in the lanes `second` leaves clear, `first + 1` where it is set.
+    #[inline(always)]
+    pub fn of_pair(first: i32, second: M8) -> Self {
+        Index8(from_fn(|i| first.wrapping_sub(second.0[i])))
+    }
+
     #[inline(always)]
     pub fn to_array(self) -> [i32; LANES] {
         self.0
