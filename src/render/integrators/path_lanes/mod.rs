@@ -1081,7 +1081,7 @@ impl Lanes {
             origin = here.select_v(V8::splat(sample.origin), origin);
             direction = here.select_v(V8::splat(sample.direction), direction);
             inside_walls = here.select_mask(M8::splat(sample.inside_walls), inside_walls);
-            self.rng.start(here, sample.stream);
+            self.rng.start(lane, sample.stream);
             slots[lane] = *next;
             *next += 1;
         }

@@ -275,11 +275,10 @@ impl Rng8 {
         self.state
     }
 
-    /// The lanes of `mask` take up the stream at `state`.
+    /// Lane `lane` takes up the stream at `state`.
     #[inline(always)]
-    pub fn start(&mut self, mask: M8, state: u64) {
-        let mask = mask.to_array();
-        self.state = each(|i| if mask[i] != 0 { state } else { self.state[i] });
+    pub fn start(&mut self, lane: usize, state: u64) {
+        self.state[lane] = state;
     }
 
     /// `Sampler::next_f32` in the lanes of `mask` (others: unchanged, value unused).
@@ -343,7 +342,7 @@ mod tests {
             if round % 5 == 4 {
                 let lane = round % LANES;
                 samplers[lane] = Sampler::new(100 + round as u64, 3, 9);
-                rng.start(M8::only(lane), samplers[lane].state());
+                rng.start(lane, samplers[lane].state());
             }
         }
         assert_eq!(rng.states(), std::array::from_fn(|i| samplers[i].state()));
