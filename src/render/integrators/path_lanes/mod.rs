@@ -1075,13 +1075,14 @@ impl Lanes {
         while idle != 0 && *next < count {
             let lane = idle.trailing_zeros() as usize;
             idle &= idle - 1;
-            let sample = &samples.0[*next];
+            let (eight, i) = (&samples.0[*next / LANES], *next % LANES);
+            let (sample_origin, sample_direction) = eight.ray(i);
             let here = M8::only(lane);
             started = started.or(here);
-            origin = here.select_v(V8::splat(sample.origin), origin);
-            direction = here.select_v(V8::splat(sample.direction), direction);
-            inside_walls = here.select_mask(M8::splat(sample.inside_walls), inside_walls);
-            self.rng.start(lane, sample.stream);
+            origin = here.select_v(V8::splat(sample_origin), origin);
+            direction = here.select_v(V8::splat(sample_direction), direction);
+            inside_walls = here.select_mask(M8::splat(eight.inside_walls >> i & 1 != 0), inside_walls);
+            self.rng.start(lane, eight.stream[i]);
             slots[lane] = *next;
             *next += 1;
         }

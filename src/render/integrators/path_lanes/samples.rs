@@ -10,35 +10,39 @@ use crate::render::world::lanes::{self, Rng8, F8, LANES, M8, V8};
 use crate::render::world::rng::Sampler;
 use crate::render::world::World;
 
-/// One camera sample, as a lane takes it up.
+/// Eight camera samples, a row of eight per field, as the lanes hold them.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct CameraSample {
-    pub(super) origin: Vec3,
-    pub(super) direction: Vec3,
-    pub(super) stream: u64,
-    /// `Walls::hold` of the origin.
-    pub(super) inside_walls: bool,
+pub(super) struct CameraEight {
+    origin: [[f32; LANES]; 3],
+    direction: [[f32; LANES]; 3],
+    pub(super) stream: [u64; LANES],
+    /// Bit i set: sample i starts inside every wall (`Walls::hold`).
+    pub(super) inside_walls: u32,
 }
 
 /// A tile's camera samples, a whole number of eights (the last eight repeat
 /// the last sample).
-pub(super) struct CameraSamples(pub(super) Vec<CameraSample>);
+pub(super) struct CameraSamples(pub(super) Vec<CameraEight>);
 
 impl CameraSamples {
     #[inline(always)]
     pub(super) fn new(tile: &CameraTile, world: &World) -> Self {
         let mut samples = Self::rays(tile);
         // Camera rays of a tile start close together: mostly all inside the walls
-        let (mut low, mut high) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        for sample in &samples.0 {
-            (low, high) = (low.min(sample.origin), high.max(sample.origin));
+        let (mut low, mut high) = (V8::splat(Vec3::INFINITY), V8::splat(Vec3::NEG_INFINITY));
+        for eight in &samples.0 {
+            let origin = eight.origins();
+            low = V8 { x: low.x.min(origin.x), y: low.y.min(origin.y), z: low.z.min(origin.z) };
+            high = V8 { x: high.x.max(origin.x), y: high.y.max(origin.y), z: high.z.max(origin.z) };
         }
-        if !world.walls.hold_box(low, high) {
-            for entry in samples.0.chunks_exact_mut(LANES) {
-                let held = world.walls.hold_lanes(V8::from_fn(|i| entry[i].origin)).to_array();
-                for (sample, held) in entry.iter_mut().zip(held) {
-                    sample.inside_walls = held != 0;
-                }
+        // Plain loops: a closure here would not inherit AVX2
+        let (mut lowest, mut highest) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for i in 0..LANES {
+            (lowest, highest) = (lowest.min(low.lane(i)), highest.max(high.lane(i)));
+        }
+        if !world.walls.hold_box(lowest, highest) {
+            for eight in &mut samples.0 {
+                eight.inside_walls = world.walls.hold_lanes(eight.origins()).bits();
             }
         }
         samples
@@ -48,7 +52,7 @@ impl CameraSamples {
     #[inline(always)]
     fn rays(tile: &CameraTile) -> Self {
         let entries = tile.len().div_ceil(LANES);
-        let mut samples = CameraSamples(Vec::with_capacity(entries * LANES));
+        let mut samples = CameraSamples(Vec::with_capacity(entries));
         let last = tile.len().saturating_sub(1);
         if tile.camera.has_lens() {
             for entry in 0..entries {
@@ -86,15 +90,23 @@ impl CameraSamples {
     /// Eight samples, taken to be inside the walls until `new` knows better.
     #[inline(always)]
     fn push(&mut self, origin: V8, direction: V8, stream: [u64; LANES]) {
-        let (ox, oy, oz) = (origin.x.to_array(), origin.y.to_array(), origin.z.to_array());
-        let (dx, dy, dz) = (direction.x.to_array(), direction.y.to_array(), direction.z.to_array());
-        for i in 0..LANES {
-            self.0.push(CameraSample {
-                origin: Vec3::new(ox[i], oy[i], oz[i]),
-                direction: Vec3::new(dx[i], dy[i], dz[i]),
-                stream: stream[i],
-                inside_walls: true,
-            });
-        }
+        let rows = |v: V8| [v.x.to_array(), v.y.to_array(), v.z.to_array()];
+        let (origin, direction) = (rows(origin), rows(direction));
+        self.0.push(CameraEight { origin, direction, stream, inside_walls: (1 << LANES) - 1 });
+    }
+}
+
+impl CameraEight {
+    #[inline(always)]
+    fn origins(&self) -> V8 {
+        let [x, y, z] = &self.origin;
+        V8 { x: F8::load(x), y: F8::load(y), z: F8::load(z) }
+    }
+
+    /// Sample `i`'s origin and direction.
+    #[inline(always)]
+    pub(super) fn ray(&self, i: usize) -> (Vec3, Vec3) {
+        let ([ox, oy, oz], [dx, dy, dz]) = (&self.origin, &self.direction);
+        (Vec3::new(ox[i], oy[i], oz[i]), Vec3::new(dx[i], dy[i], dz[i]))
     }
 }
