@@ -80,6 +80,8 @@ struct Surface {
 struct SphereInfo {
     center: Vec3,
     radius2: f32,
+    /// Its index among the shapes, as the lanes count them.
+    shape: f32,
     /// A wall (`occluders::Walls`), about its point nearest the camera:
     /// paths inside every wall meet it only on their way out (`wall_exit`).
     wall: Option<AnchoredSphere>,
@@ -179,6 +181,9 @@ pub struct PathLanes {
     background: Rgb,
     /// The walls, as held rays ask where they leave.
     wall_exits: WallExits,
+    /// The spheres that are not walls, which is all a held ray asks of
+    /// the spheres but where it leaves them.
+    inner_spheres: Vec<SphereInfo>,
 }
 
 impl PathLanes {
@@ -229,7 +234,7 @@ impl PathLanes {
         let spheres: Vec<SphereInfo> = (0..s.radius.len())
             .map(|i| {
                 let radius = s.radius[i];
-                SphereInfo { center: s.center(i), radius2: radius * radius, wall: wall(i) }
+                SphereInfo { center: s.center(i), radius2: radius * radius, shape: i as f32, wall: wall(i) }
             })
             .collect();
         let planes: Vec<PlaneInfo> = (world.planes.iter())
@@ -267,7 +272,9 @@ impl PathLanes {
         let (walls, others) = (0..spheres.len()).partition::<Vec<_>, _>(|&i| spheres[i].wall.is_some());
         let before_planes = std::iter::repeat_n(None, spheres.len());
         let by_shape = || before_planes.clone().chain(planes.iter().map(Some));
+        let inner_spheres = spheres.iter().filter(|s| s.wall.is_none()).copied().collect();
         Some(PathLanes {
+            inner_spheres,
             others: others.into_iter().map(occluder).collect(),
             walls: walls.into_iter().map(occluder).collect(),
             sphere_columns: SphereColumns::new(&spheres, &s.radius),
@@ -589,25 +596,21 @@ impl PathLanes {
         // Of the sphere hit so far: whether by its near root, and the
         // discriminant (`sphere_hits` rebuilds the point from them)
         let (mut sphere_near, mut sphere_discriminant) = (M8::NONE, F8::splat(0.0));
-        let mut k = F8::splat(0.0);
-        for sphere in &self.spheres {
-            if sphere.wall.is_none() || !every_held {
-                let f = origin - V8::splat(sphere.center);
-                // No lane's line meets it: no root to solve (`roots`' discriminant)
-                let b = f.dot(direction);
-                let discriminant = F8::splat(sphere.radius2) - (f - direction * b).length_squared();
-                if !discriminant.ge(F8::splat(0.0)).and(active).any() {
-                    k = k + 1.0;
-                    continue;
-                }
-                let (t, closer, near) = nearest_root(f, direction, F8::splat(sphere.radius2), t_hit);
-                let closer = if sphere.wall.is_some() { closer.and_not(held) } else { closer };
-                t_hit = closer.select(t, t_hit);
-                index = closer.select(k, index);
-                sphere_near = closer.select_mask(near, sphere_near);
-                sphere_discriminant = closer.select(discriminant, sphere_discriminant);
+        let spheres = if every_held { &self.inner_spheres } else { &self.spheres };
+        for sphere in spheres {
+            let f = origin - V8::splat(sphere.center);
+            // No lane's line meets it: no root to solve (`roots`' discriminant)
+            let b = f.dot(direction);
+            let discriminant = F8::splat(sphere.radius2) - (f - direction * b).length_squared();
+            if !discriminant.ge(F8::splat(0.0)).and(active).any() {
+                continue;
             }
-            k = k + 1.0;
+            let (t, closer, near) = nearest_root(f, direction, F8::splat(sphere.radius2), t_hit);
+            let closer = if sphere.wall.is_some() { closer.and_not(held) } else { closer };
+            t_hit = closer.select(t, t_hit);
+            index = closer.select(F8::splat(sphere.shape), index);
+            sphere_near = closer.select_mask(near, sphere_near);
+            sphere_discriminant = closer.select(discriminant, sphere_discriminant);
         }
         // The walls' ways out for held paths, after every other sphere:
         // a tie with one goes to the other sphere, as in `World::intersect_held`
