@@ -96,9 +96,23 @@ pub fn wall_exit<R: Real>(
     radius: R,
     t_max: R,
 ) -> (R, R::Mask) {
+    wall_exit_along(origin, direction, anchor, normal, normal.dot(direction), radius, t_max)
+}
+
+/// `wall_exit` given `along`, the ray's n · d.
+#[inline(always)]
+pub fn wall_exit_along<R: Real>(
+    origin: V3<R>,
+    direction: V3<R>,
+    anchor: V3<R>,
+    normal: V3<R>,
+    along: R,
+    radius: R,
+    t_max: R,
+) -> (R, R::Mask) {
     let e = origin - anchor;
     // f = o − c = e + r·n, never formed: b = f · d, c = |f|² − r²
-    let b = e.dot(direction) + radius * normal.dot(direction);
+    let b = e.dot(direction) + radius * along;
     let c = e.dot(e) + (radius + radius) * e.dot(normal);
     let root = (b * b - c).max(R::splat(0.0)).sqrt();
     let zero = R::splat(0.0);

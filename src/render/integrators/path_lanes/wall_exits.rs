@@ -16,7 +16,7 @@
 
 use glam::{DMat3, DVec3};
 
-use crate::geometry::sphere::{wall_exit, AnchoredSphere};
+use crate::geometry::sphere::{wall_exit, wall_exit_along, AnchoredSphere};
 use crate::render::world::lanes::{Index8, F8, LANES, M8, V8};
 
 /// Opposite walls: normals at least this far from each other's (cosine).
@@ -127,7 +127,12 @@ impl WallExits {
                     let [ax, ay, az, nx, ny, nz, radius, shape] = &self.slots;
                     let anchor = V8 { x: pick(ax, slot), y: pick(ay, slot), z: pick(az, slot) };
                     let normal = V8 { x: pick(nx, slot), y: pick(ny, slot), z: pick(nz, slot) };
-                    let (t, exits) = wall_exit(origin, direction, anchor, normal, pick(radius, slot), *t_hit);
+                    // The chosen wall's n · d is the larger (equal ones differ at most
+                    // in the sign of a zero, which b = e · d + r (n · d) and all
+                    // that follows from it cannot tell)
+                    let along = along_first.max(along_second);
+                    let (t, exits) =
+                        wall_exit_along(origin, direction, anchor, normal, along, pick(radius, slot), *t_hit);
                     keep(exits.and(held), t, pick(shape, slot), t_hit, index);
                 }
             }
