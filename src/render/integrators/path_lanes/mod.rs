@@ -1085,7 +1085,7 @@ impl Lanes {
             origin = here.select_v(V8::splat(sample_origin), origin);
             direction = here.select_v(V8::splat(sample_direction), direction);
             inside_walls = here.select_mask(M8::splat(eight.inside_walls >> i & 1 != 0), inside_walls);
-            self.rng.start(lane, eight.stream[i]);
+            self.rng.start(lane, eight.stream[i], eight.ahead[i]);
             slots[lane] = *next;
             *next += 1;
         }

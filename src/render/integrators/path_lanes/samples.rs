@@ -16,6 +16,8 @@ pub(super) struct CameraEight {
     origin: [[f32; LANES]; 3],
     direction: [[f32; LANES]; 3],
     pub(super) stream: [u64; LANES],
+    /// Each stream's next draw, mixed (`Rng8::ahead`).
+    pub(super) ahead: [u64; LANES],
     /// Bit i set: sample i starts inside every wall (`Walls::hold`).
     pub(super) inside_walls: u32,
 }
@@ -58,7 +60,8 @@ impl CameraSamples {
             for entry in 0..entries {
                 let rays: [(Ray, Sampler); LANES] = lanes::each(|i| tile.sample((entry * LANES + i).min(last)));
                 let origin = V8::from_fn(|i| rays[i].0.origin);
-                samples.push(origin, V8::from_fn(|i| rays[i].0.direction), rays.map(|(_, s)| s.state()));
+                let streams = Rng8::from_states(lanes::each(|i| rays[i].1.state()));
+                samples.push(origin, V8::from_fn(|i| rays[i].0.direction), &streams);
             }
             return samples;
         }
@@ -82,17 +85,18 @@ impl CameraSamples {
             let film_x = F8::from_fn(|i| column[i] as f32) + u0;
             let film_y = F8::from_fn(|i| row[i] as f32) + u1;
             let (origin, direction) = tile.camera.pinhole_rays_of(film_x, film_y);
-            samples.push(origin, direction, rng.states());
+            samples.push(origin, direction, &rng);
         }
         samples
     }
 
     /// Eight samples, taken to be inside the walls until `new` knows better.
     #[inline(always)]
-    fn push(&mut self, origin: V8, direction: V8, stream: [u64; LANES]) {
+    fn push(&mut self, origin: V8, direction: V8, streams: &Rng8) {
         let rows = |v: V8| [v.x.to_array(), v.y.to_array(), v.z.to_array()];
         let (origin, direction) = (rows(origin), rows(direction));
-        self.0.push(CameraEight { origin, direction, stream, inside_walls: (1 << LANES) - 1 });
+        let (stream, ahead) = (streams.states(), streams.ahead());
+        self.0.push(CameraEight { origin, direction, stream, ahead, inside_walls: (1 << LANES) - 1 });
     }
 }
 
