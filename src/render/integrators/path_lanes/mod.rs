@@ -504,8 +504,9 @@ impl PathLanes {
         let facing = normal.dot(wo).lt(F8::splat(0.0)).select_v(-normal, normal);
         let zero = F8::splat(0.0);
 
-        // Next-event estimation toward one light, chosen uniformly
-        if light_count > 0 && diffuse.any() {
+        // Next-event estimation toward one light, chosen uniformly: its
+        // draws, then the scattering's, as each lane has always drawn them
+        let shading = if light_count > 0 && diffuse.any() {
             let pick: [usize; LANES] = if light_count == 1 {
                 [0; LANES]
             } else {
@@ -513,7 +514,16 @@ impl PathLanes {
                 let u_pick = u_pick.to_array();
                 lanes::each(|i| ((u_pick[i] * light_count as f32) as usize).min(light_count - 1))
             };
-            let u = st.rng.next_2d(diffuse);
+            Some((pick, st.rng.next_2d(diffuse)))
+        } else {
+            None
+        };
+        // Scattering, each material drawing what it uses (`Bsdf::sample`),
+        // before the light's work, which it does not need: written after
+        // it, it waited on that chain of dependent work
+        let Scattered { go, wi, weight, pdf, .. } =
+            surfaces.scatter(&mut st.rng, wo, normal, facing, Transport::Radiance);
+        if let Some((pick, u)) = shading {
             let light = LightLanes::sample(&self.lights, world, &pick, diffuse, point, normal, error, u, &hit);
             // f (Lambert's albedo / π) where both directions are above the surface
             let above = !light.wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
@@ -548,10 +558,6 @@ impl PathLanes {
                 }
             }
         }
-
-        // Scattering: each material draws what it uses (`Bsdf::sample`)
-        let Scattered { go, wi, weight, pdf, .. } =
-            surfaces.scatter(&mut st.rng, wo, normal, facing, Transport::Radiance);
         let done = missed.or(alive.and_not(go));
         if !go.any() {
             return done;
