@@ -143,6 +143,16 @@ fn other_lights_bit_for_bit() {
     assert_lanes_match_scalar(&scene, 32, 1);
 }
 
+/// A scene lit by one triangle: its points are drawn before the hit is
+/// known, as smallpt's cap's are (`LaneLights::drawn_ahead`).
+#[test]
+fn one_triangle_light_bit_for_bit() {
+    let mut scene = preset("cornell");
+    scene.objects.retain(|object| object.name != "panel b");
+    let lit = assert_lanes_match_scalar(&scene, 16, 2);
+    assert!(lit > 1000, "only {lit} samples carried light");
+}
+
 /// A path off a black surface can carry no more light: it ends there (one
 /// ray a sample), not after the bounces before Russian roulette may end it.
 #[test]

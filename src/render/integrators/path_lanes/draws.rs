@@ -105,7 +105,7 @@ impl PathLanes {
                     error: error.lane(i),
                 };
                 let index = lanes::each(|i| picked[i].map_or(0, |(index, _)| index));
-                Some(LightLanes::sample(&self.lights, world, &index, sampled, point, normal, error, u, &hit))
+                Some(LightLanes::sample(&self.lights, world, &index, sampled, point, normal, error, u, None, &hit))
             }
             false => None,
         };

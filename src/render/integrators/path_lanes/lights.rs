@@ -192,6 +192,18 @@ impl LaneLights {
         }
     }
 
+    /// The one light's point for the draw `u`, where the scene has one light
+    /// and the point does not depend on what it lights (a cap, a triangle):
+    /// drawn before the hit is known, its work overlaps the hit's.
+    #[inline(always)]
+    pub(super) fn drawn_ahead(&self, u: (F8, F8)) -> Option<OnLight> {
+        match &self.lights[..] {
+            [Some(LaneLight::Cap(cap))] => Some(on_caps(&PerLane::One(cap), u)),
+            [Some(LaneLight::Triangle(triangle))] => Some(on_triangles(&PerLane::One(triangle), u)),
+            _ => None,
+        }
+    }
+
     /// The lanes of `mask` whose light is of one kind (`kind`, the `which`th
     /// kind), and their lights; `None` if there are no such lanes.
     #[inline(always)]
@@ -282,18 +294,26 @@ impl Drawn {
     }
 }
 
+impl OnLight {
+    /// The draw as seen from `p`: its solid-angle pdf there.
+    #[inline(always)]
+    fn seen_from(self, p: V8) -> Drawn {
+        let pdf = solid_angle_pdf_of(p, self.point, self.normal, self.area);
+        Drawn { target: self.point, normal: self.normal, error: self.error, pdf, radiance: self.radiance }
+    }
+}
+
 /// Uniform over each lane's cap (`sample_area`).
 #[inline(always)]
-fn draw_on_caps(caps: &PerLane<CapLight>, p: V8, u: (F8, F8)) -> Drawn {
+fn on_caps(caps: &PerLane<CapLight>, u: (F8, F8)) -> OnLight {
     // Written out: `array::from_fn` is left out of line, without AVX2
     let frame = [caps.v8(|cap| cap.frame[0]), caps.v8(|cap| cap.frame[1]), caps.v8(|cap| cap.frame[2])];
     let normal = to_world(frame, uniform_cone_of(u.0, u.1, caps.f8(|cap| cap.one_minus_cos)));
-    let target = caps.v8(|cap| cap.center) + normal * caps.f8(|cap| cap.radius);
-    Drawn {
-        target,
+    OnLight {
+        point: caps.v8(|cap| cap.center) + normal * caps.f8(|cap| cap.radius),
         normal,
         error: caps.f8(|cap| cap.error),
-        pdf: solid_angle_pdf_of(p, target, normal, caps.f8(|cap| cap.area)),
+        area: caps.f8(|cap| cap.area),
         radiance: caps.v8(|cap| cap.radiance),
     }
 }
@@ -346,15 +366,13 @@ fn triangle_vertices(triangles: &PerLane<TriangleLight>) -> [V8; 3] {
 
 /// Uniform over each lane's triangle (`sample_area`).
 #[inline(always)]
-fn draw_on_triangles(triangles: &PerLane<TriangleLight>, p: V8, u: (F8, F8)) -> Drawn {
+fn on_triangles(triangles: &PerLane<TriangleLight>, u: (F8, F8)) -> OnLight {
     let (b0, b1) = uniform_triangle_of(u.0, u.1);
-    let target = triangle_point_of(triangle_vertices(triangles), b0, b1);
-    let normal = triangles.v8(|triangle| triangle.normal);
-    Drawn {
-        target,
-        normal,
+    OnLight {
+        point: triangle_point_of(triangle_vertices(triangles), b0, b1),
+        normal: triangles.v8(|triangle| triangle.normal),
         error: triangles.f8(|triangle| triangle.error),
-        pdf: solid_angle_pdf_of(p, target, normal, triangles.f8(|triangle| triangle.area)),
+        area: triangles.f8(|triangle| triangle.area),
         radiance: triangles.v8(|triangle| triangle.radiance),
     }
 }
@@ -405,6 +423,7 @@ impl LightLanes {
         normal: V8,
         error: F8,
         u: (F8, F8),
+        ahead: Option<OnLight>,
         hit: &impl Fn(usize) -> SurfaceHit,
     ) -> LightLanes {
         let mut out = LightLanes {
@@ -419,17 +438,22 @@ impl LightLanes {
             light_normal: V8::splat(Vec3::ZERO),
         };
         let (mut drawn, mut in_lanes) = (None, M8::NONE);
-        if let Some((lanes, caps)) = lights.of_kind(pick, mask, 0, LaneLight::cap) {
-            drawn = Some(draw_on_caps(&caps, point, u).over(lanes, drawn));
-            in_lanes = in_lanes.or(lanes);
-        }
-        if let Some((lanes, spheres)) = lights.of_kind(pick, mask, 1, LaneLight::sphere) {
-            drawn = Some(draw_on_spheres(&spheres, lanes, point, u).over(lanes, drawn));
-            in_lanes = in_lanes.or(lanes);
-        }
-        if let Some((lanes, triangles)) = lights.of_kind(pick, mask, 2, LaneLight::triangle) {
-            drawn = Some(draw_on_triangles(&triangles, point, u).over(lanes, drawn));
-            in_lanes = in_lanes.or(lanes);
+        if let Some(on_light) = ahead {
+            // The one light, its point drawn ahead
+            (drawn, in_lanes) = (Some(on_light.seen_from(point)), mask);
+        } else {
+            if let Some((lanes, caps)) = lights.of_kind(pick, mask, 0, LaneLight::cap) {
+                drawn = Some(on_caps(&caps, u).seen_from(point).over(lanes, drawn));
+                in_lanes = in_lanes.or(lanes);
+            }
+            if let Some((lanes, spheres)) = lights.of_kind(pick, mask, 1, LaneLight::sphere) {
+                drawn = Some(draw_on_spheres(&spheres, lanes, point, u).over(lanes, drawn));
+                in_lanes = in_lanes.or(lanes);
+            }
+            if let Some((lanes, triangles)) = lights.of_kind(pick, mask, 2, LaneLight::triangle) {
+                drawn = Some(on_triangles(&triangles, u).seen_from(point).over(lanes, drawn));
+                in_lanes = in_lanes.or(lanes);
+            }
         }
         if let Some(Drawn { target, normal: light_normal, error: light_error, pdf, radiance }) = drawn {
             // The shadow ray (`SurfaceHit::spawn_ray_to`)
@@ -492,8 +516,10 @@ pub(crate) struct EmittedLanes {
     pub(crate) power: V8,
 }
 
-/// Points drawn uniformly on area lights, before their direction.
-struct OnLight {
+/// Points drawn uniformly on area lights: before their direction (light
+/// leaving them), or before the point they light is known (on caps and
+/// triangles the draw does not depend on it).
+pub(super) struct OnLight {
     point: V8,
     normal: V8,
     error: F8,
@@ -533,12 +559,7 @@ impl LaneLights {
         let (mut on_light, mut in_lanes) = (None, M8::NONE);
         // A point uniform over the light's area (`point_on_emitter`)
         if let Some((lanes, caps)) = self.of_kind(pick, mask, 0, LaneLight::cap) {
-            let frame = [caps.v8(|cap| cap.frame[0]), caps.v8(|cap| cap.frame[1]), caps.v8(|cap| cap.frame[2])];
-            let normal = to_world(frame, uniform_cone_of(u1.0, u1.1, caps.f8(|cap| cap.one_minus_cos)));
-            let point = caps.v8(|cap| cap.center) + normal * caps.f8(|cap| cap.radius);
-            let (error, area, radiance) =
-                (caps.f8(|cap| cap.error), caps.f8(|cap| cap.area), caps.v8(|cap| cap.radiance));
-            on_light = Some(OnLight { point, normal, error, area, radiance }.over(lanes, on_light));
+            on_light = Some(on_caps(&caps, u1).over(lanes, on_light));
             in_lanes = in_lanes.or(lanes);
         }
         if let Some((lanes, spheres)) = self.of_kind(pick, mask, 1, LaneLight::sphere) {
@@ -550,12 +571,7 @@ impl LaneLights {
             in_lanes = in_lanes.or(lanes);
         }
         if let Some((lanes, triangles)) = self.of_kind(pick, mask, 2, LaneLight::triangle) {
-            let (b0, b1) = uniform_triangle_of(u1.0, u1.1);
-            let point = triangle_point_of(triangle_vertices(&triangles), b0, b1);
-            let normal = triangles.v8(|triangle| triangle.normal);
-            let (error, area) = (triangles.f8(|triangle| triangle.error), triangles.f8(|triangle| triangle.area));
-            let radiance = triangles.v8(|triangle| triangle.radiance);
-            on_light = Some(OnLight { point, normal, error, area, radiance }.over(lanes, on_light));
+            on_light = Some(on_triangles(&triangles, u1).over(lanes, on_light));
             in_lanes = in_lanes.or(lanes);
         }
         if let Some(OnLight { point, normal, error, area, radiance }) = on_light {

@@ -457,6 +457,9 @@ impl PathLanes {
         let (origin, direction) = (st.origin, st.direction);
 
         let held = st.inside_walls;
+        // The one light's point for the light draw ahead (a lane's first
+        // draw this bounce), where it does not depend on the hit
+        let light_ahead = if world.lights.len() == 1 { self.lights.drawn_ahead(st.rng.peek_2d()) } else { None };
         let LaneHits { found, t: t_hit, shape, point, normal, error } = self.nearest(active, held, origin, direction);
         let missed = active.and_not(found);
         let light_count = world.lights.len();
@@ -524,7 +527,8 @@ impl PathLanes {
         let Scattered { go, wi, weight, pdf, .. } =
             surfaces.scatter(&mut st.rng, wo, normal, facing, Transport::Radiance);
         if let Some((pick, u)) = shading {
-            let light = LightLanes::sample(&self.lights, world, &pick, diffuse, point, normal, error, u, &hit);
+            let light =
+                LightLanes::sample(&self.lights, world, &pick, diffuse, point, normal, error, u, light_ahead, &hit);
             // f (Lambert's albedo / π) where both directions are above the surface
             let above = !light.wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
             let mut f = color * F8::splat(FRAC_1_PI);

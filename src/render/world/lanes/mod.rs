@@ -307,7 +307,15 @@ impl Rng8 {
     /// `Sampler::next_2d` in the lanes of `mask`.
     #[inline(always)]
     pub fn next_2d(&mut self, mask: M8) -> (F8, F8) {
-        let bits = self.next_bits(mask);
+        let drawn = self.peek_2d();
+        self.next_bits(mask);
+        drawn
+    }
+
+    /// What `next_2d` will return, without drawing it.
+    #[inline(always)]
+    pub fn peek_2d(&self) -> (F8, F8) {
+        let bits = self.ahead;
         let u0 = F8::from_fn(|i| unit_from_24_bits(bits[i] >> 40));
         (u0, F8::from_fn(|i| unit_from_24_bits((bits[i] >> 16) & 0xff_ffff)))
     }
