@@ -508,7 +508,10 @@ impl PathLanes {
         let zero = F8::splat(0.0);
 
         // Next-event estimation toward one light, chosen uniformly: its
-        // draws, then the scattering's, as each lane has always drawn them
+        // draws and its point, then the scattering (drawing after the
+        // light, as each lane has always drawn), then the shadow ray. So
+        // ordered, each long chain of dependent work (the light's point,
+        // the next ray) starts before the work that waits on the other
         let shading = if light_count > 0 && diffuse.any() {
             let pick: [usize; LANES] = if light_count == 1 {
                 [0; LANES]
@@ -517,18 +520,18 @@ impl PathLanes {
                 let u_pick = u_pick.to_array();
                 lanes::each(|i| ((u_pick[i] * light_count as f32) as usize).min(light_count - 1))
             };
-            Some((pick, st.rng.next_2d(diffuse)))
+            let u = st.rng.next_2d(diffuse);
+            Some((
+                pick,
+                LightLanes::sample(&self.lights, world, &pick, diffuse, point, normal, error, u, light_ahead, &hit),
+            ))
         } else {
             None
         };
-        // Scattering, each material drawing what it uses (`Bsdf::sample`),
-        // before the light's work, which it does not need: written after
-        // it, it waited on that chain of dependent work
+        // Scattering, each material drawing what it uses (`Bsdf::sample`)
         let Scattered { go, wi, weight, pdf, .. } =
             surfaces.scatter(&mut st.rng, wo, normal, facing, Transport::Radiance);
-        if let Some((pick, u)) = shading {
-            let light =
-                LightLanes::sample(&self.lights, world, &pick, diffuse, point, normal, error, u, light_ahead, &hit);
+        if let Some((pick, light)) = shading {
             // f (Lambert's albedo / π) where both directions are above the surface
             let above = !light.wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
             let mut f = color * F8::splat(FRAC_1_PI);
