@@ -6,10 +6,9 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use crate::geometry::sphere::nearest_root;
 use crate::geometry::{frame_from_z, offset_origin, ray_to, to_world, SurfaceHit};
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
-use crate::render::world::light::{solid_angle_pdf_of, triangle_point_of, Emitter, LightSource};
+use crate::render::world::light::{solid_angle_pdf_of, sphere_cone_normal_of, triangle_point_of, Emitter, LightSource};
 use crate::render::world::sampling::{cosine_hemisphere_of, uniform_cone_of, uniform_cone_pdf_of};
 use crate::render::world::sampling::{uniform_sphere_of, uniform_triangle_of};
 use crate::render::world::World;
@@ -321,7 +320,7 @@ fn on_caps(caps: &PerLane<CapLight>, u: (F8, F8)) -> OnLight {
 /// Uniform over the cone each lane's sphere subtends, the point where the
 /// direction meets the sphere (`sample_area`); pdf 0 from inside it.
 #[inline(always)]
-fn draw_on_spheres(spheres: &PerLane<SphereLight>, lanes: M8, p: V8, u: (F8, F8)) -> Drawn {
+fn draw_on_spheres(spheres: &PerLane<SphereLight>, p: V8, u: (F8, F8)) -> Drawn {
     let (center, radius) = (spheres.v8(|sphere| sphere.center), spheres.f8(|sphere| sphere.radius));
     let one = F8::splat(1.0);
     let to_center = center - p;
@@ -329,21 +328,7 @@ fn draw_on_spheres(spheres: &PerLane<SphereLight>, lanes: M8, p: V8, u: (F8, F8)
     let sin2_max = radius * radius / distance2;
     let one_minus_cos = sin2_max / (one + (one - sin2_max).sqrt());
     let axis = to_center / distance2.sqrt();
-    let direction = to_world(frame_from_z(axis), uniform_cone_of(u.0, u.1, one_minus_cos));
-    // `intersect_sphere` (`sphere_hit`'s point from the closest approach)
-    let f = p - center;
-    let (_, hit, near) = nearest_root(f, direction, radius * radius, F8::splat(f32::INFINITY));
-    let closest = f - direction * f.dot(direction);
-    let half_chord = (radius * radius - closest.length_squared()).max(F8::splat(0.0)).sqrt();
-    let from_center = near.select_v(closest - direction * half_chord, closest + direction * half_chord);
-    let length = from_center.length();
-    let hit_normal = length.gt(F8::splat(0.0)).select_v(from_center / length, -direction);
-    // The cone's edge rays may miss by rounding (rarely): the closest approach
-    let mut normal = hit_normal;
-    if lanes.and_not(hit).any() {
-        let miss_normal = (p + direction * to_center.dot(direction) - center).normalize();
-        normal = hit.select_v(hit_normal, miss_normal);
-    }
+    let normal = sphere_cone_normal_of(axis, sin2_max, one_minus_cos, u.0, u.1);
     Drawn {
         target: center + normal * radius,
         normal,
@@ -447,7 +432,7 @@ impl LightLanes {
                 in_lanes = in_lanes.or(lanes);
             }
             if let Some((lanes, spheres)) = lights.of_kind(pick, mask, 1, LaneLight::sphere) {
-                drawn = Some(draw_on_spheres(&spheres, lanes, point, u).over(lanes, drawn));
+                drawn = Some(draw_on_spheres(&spheres, point, u).over(lanes, drawn));
                 in_lanes = in_lanes.or(lanes);
             }
             if let Some((lanes, triangles)) = lights.of_kind(pick, mask, 2, LaneLight::triangle) {
