@@ -457,12 +457,12 @@ impl PathLanes {
         let (origin, direction) = (st.origin, st.direction);
 
         let held = st.inside_walls;
+        let light_count = world.lights.len();
         // The one light's point for the light draw ahead (a lane's first
         // draw this bounce), where it does not depend on the hit
-        let light_ahead = if world.lights.len() == 1 { self.lights.drawn_ahead(st.rng.peek_2d()) } else { None };
+        let light_ahead = if light_count == 1 { self.lights.drawn_ahead(st.rng.peek_2d()) } else { None };
         let LaneHits { found, t: t_hit, shape, point, normal, error } = self.nearest(active, held, origin, direction);
         let missed = active.and_not(found);
-        let light_count = world.lights.len();
         let pick_pdf = 1.0 / light_count.max(1) as f32;
         if missed.any() {
             // The background, weighted against sampling it as a light
