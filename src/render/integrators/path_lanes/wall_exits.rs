@@ -16,7 +16,7 @@
 
 use glam::{DMat3, DVec3};
 
-use crate::geometry::sphere::{wall_exit, wall_exit_along, AnchoredSphere};
+use crate::geometry::sphere::{wall_exit_along, AnchoredSphere};
 use crate::render::world::lanes::{Index8, F8, LANES, M8, V8};
 
 /// Opposite walls: normals at least this far from each other's (cosine).
@@ -111,7 +111,10 @@ impl WallExits {
         // Plain code: a closure here would not inherit AVX2
         for unit in &self.units {
             match unit {
-                WallUnit::Single(wall) => ask(wall, held, origin, direction, t_hit, index),
+                WallUnit::Single(wall) => {
+                    let along = V8::splat(wall.sphere.normal).dot(direction);
+                    ask(wall, along, held, origin, direction, t_hit, index);
+                }
                 WallUnit::Pair(pair) => {
                     let [first, second] = &pair.walls;
                     let along_first = V8::splat(first.sphere.normal).dot(direction);
@@ -119,8 +122,8 @@ impl WallExits {
                     // Both where a ray might leave by the wall it turns from
                     let turned_far = along_first.min(along_second).lt(F8::splat(pair.below));
                     if held.and_not(turned_far).any() {
-                        ask(first, held, origin, direction, t_hit, index);
-                        ask(second, held, origin, direction, t_hit, index);
+                        ask(first, along_first, held, origin, direction, t_hit, index);
+                        ask(second, along_second, held, origin, direction, t_hit, index);
                         continue;
                     }
                     let slot = Index8::of_pair(pair.first, along_second.gt(along_first));
@@ -140,11 +143,11 @@ impl WallExits {
     }
 }
 
-/// `wall_exit` of one wall for every lane.
+/// `wall_exit` of one wall for every lane, the rays' n · d (`along`) given.
 #[inline(always)]
-fn ask(wall: &Wall, held: M8, origin: V8, direction: V8, t_hit: &mut F8, index: &mut F8) {
+fn ask(wall: &Wall, along: F8, held: M8, origin: V8, direction: V8, t_hit: &mut F8, index: &mut F8) {
     let (anchor, normal) = (V8::splat(wall.sphere.anchor), V8::splat(wall.sphere.normal));
-    let (t, exits) = wall_exit(origin, direction, anchor, normal, F8::splat(wall.sphere.radius), *t_hit);
+    let (t, exits) = wall_exit_along(origin, direction, anchor, normal, along, F8::splat(wall.sphere.radius), *t_hit);
     keep(exits.and(held), t, F8::splat(wall.shape), t_hit, index);
 }
 
@@ -266,6 +269,7 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
+    use crate::geometry::sphere::wall_exit;
     use crate::render::world::camera::CameraModel;
     use crate::render::world::lanes::supported;
     use crate::render::world::rng::Sampler;
@@ -312,7 +316,10 @@ mod tests {
     fn every_wall(walls: &[(u32, AnchoredSphere)], held: M8, origin: V8, direction: V8) -> (F8, F8) {
         let (mut t_hit, mut index) = (F8::splat(f32::INFINITY), F8::splat(-1.0));
         for &(shape, sphere) in walls {
-            ask(&Wall { sphere, shape: shape as f32 }, held, origin, direction, &mut t_hit, &mut index);
+            let (anchor, normal, radius) =
+                (V8::splat(sphere.anchor), V8::splat(sphere.normal), F8::splat(sphere.radius));
+            let (t, exits) = wall_exit(origin, direction, anchor, normal, radius, t_hit);
+            keep(exits.and(held), t, F8::splat(shape as f32), &mut t_hit, &mut index);
         }
         (t_hit, index)
     }
@@ -397,7 +404,7 @@ mod tests {
                 for wall in &pair.walls {
                     let along = V8::splat(wall.sphere.normal).dot(direction);
                     let (mut t, mut shape) = (F8::splat(f32::INFINITY), F8::splat(-1.0));
-                    ask(wall, held, origin, direction, &mut t, &mut shape);
+                    ask(wall, along, held, origin, direction, &mut t, &mut shape);
                     for i in along.lt(F8::splat(pair.below)).and(held).lanes() {
                         assert!(t.lane(i) > t_all.lane(i), "{:?} leaves {wall:?} at {}", rays[i], t.lane(i));
                     }

@@ -307,17 +307,13 @@ impl Rng8 {
     /// `Sampler::next_2d` in the lanes of `mask`.
     #[inline(always)]
     pub fn next_2d(&mut self, mask: M8) -> (F8, F8) {
-        let drawn = self.peek_2d();
-        self.next_bits(mask);
-        drawn
+        unit_pairs(self.next_bits(mask))
     }
 
     /// What `next_2d` will return, without drawing it.
     #[inline(always)]
     pub fn peek_2d(&self) -> (F8, F8) {
-        let bits = self.ahead;
-        let u0 = F8::from_fn(|i| unit_from_24_bits(bits[i] >> 40));
-        (u0, F8::from_fn(|i| unit_from_24_bits((bits[i] >> 16) & 0xff_ffff)))
+        unit_pairs(self.ahead)
     }
 
     /// `Sampler::next_u64` in the lanes of `mask`; the draw after it mixed
@@ -332,6 +328,13 @@ impl Rng8 {
         self.ahead = each(|i| if mask[i] != 0 { after[i] } else { self.ahead[i] });
         bits
     }
+}
+
+/// `Sampler::next_2d`'s two uniforms of each lane's draw.
+#[inline(always)]
+fn unit_pairs(bits: [u64; LANES]) -> (F8, F8) {
+    let u0 = F8::from_fn(|i| unit_from_24_bits(bits[i] >> 40));
+    (u0, F8::from_fn(|i| unit_from_24_bits((bits[i] >> 16) & 0xff_ffff)))
 }
 
 impl Default for Rng8 {
