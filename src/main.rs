@@ -10,7 +10,7 @@ use gi_studio::cli::Command;
 #[command(
     name = "gi-studio",
     version,
-    about = "A studio for global illumination: Whitted ray tracing, path tracing, photon mapping and progressive photon mapping side by side."
+    about = "A studio for global illumination: Whitted ray tracing, path tracing, photon mapping, progressive photon mapping, light tracing, bidirectional path tracing, bidirectional photon mapping and vertex connection and merging, side by side."
 )]
 struct Cli {
     #[command(subcommand)]

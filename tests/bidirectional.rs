@@ -574,12 +574,12 @@ fn the_caustic_seen_in_a_mirror_needs_merging() {
 #[test]
 fn the_strategies_add_up_to_the_image() {
     use gi_studio::render::integrators::bidir::strategies::{Strategy, MAX_LENGTH, SHRINK};
-    use gi_studio::render::{Algorithm, RenderEvent, RenderJob, RenderSession, Workers};
+    use gi_studio::render::{Algorithm, RenderEvent, RenderJob, RenderSession, Switch, Workers};
     let scene = std::sync::Arc::new(valid(common::detectors::diffuse_cornell()));
     for (algorithm, everywhere, name) in methods().into_iter().filter(|m| m.0 != Algorithm::Bpm) {
         let mut s = merging_everywhere(settings(algorithm, 32, 24, 16), everywhere);
         s.max_depth = MAX_LENGTH;
-        let job = RenderJob { strategies: true, ..RenderJob::new(scene.clone(), s) };
+        let job = RenderJob { strategies: Switch::new(true), ..RenderJob::new(scene.clone(), s) };
         let session = RenderSession::new(Workers::shared().unwrap(), None).unwrap();
         let generation = session.start(job);
         let (mut images, mut image) = (None, None);

@@ -536,3 +536,15 @@ fn an_edited_scene_gets_its_own_reference_and_bench_measures_against_it_from_els
     assert_eq!(cached(&cache).len(), 2);
     assert_exit(&bench(&further, "fourth"), 0);
 }
+
+/// `--help` names every algorithm the binary renders.
+#[test]
+fn help_names_every_algorithm() {
+    let output = gi_studio().arg("--help").output().unwrap();
+    assert_exit(&output, 0);
+    let help = stdout(&output).to_lowercase().replace('\n', " ");
+    let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
+    for algorithm in gi_studio::render::Algorithm::ALL {
+        assert!(help.contains(&algorithm.label().to_lowercase()), "--help does not name {}", algorithm.label());
+    }
+}

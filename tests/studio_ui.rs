@@ -7,9 +7,10 @@ use eframe::Storage as _;
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
-use gi_studio::app::StudioArgs;
 use gi_studio::app::{Selection, StudioApp};
+use gi_studio::app::{StateFile, StudioArgs};
 use gi_studio::render::world::camera::CameraModel;
+use gi_studio::render::Algorithm;
 use gi_studio::scene::Shape;
 
 /// The studio's arguments in tests: references kept under the target
@@ -85,6 +86,64 @@ fn editing_a_radius_in_the_inspector_restarts_and_undo_redo_restore_both_states(
     assert_eq!(*harness.state().scene(), edited);
 }
 
+/// Typing `0.45` into a radius is one edit when it is committed: the
+/// half-typed 0, 0. and 0.4 neither change the scene nor restart the panes,
+/// and one undo goes back to the radius before.
+#[test]
+fn a_typed_value_is_one_edit_when_committed() {
+    let mut harness = studio(1);
+    step_until(&mut harness, |app| app.panes().list()[0].state().passes() >= 1);
+    let original = harness.state().scene().clone();
+    harness.get_by_label("glass ball (sphere)").click();
+    harness.run_steps(2);
+    harness.get_by_role_and_label(Role::SpinButton, "Radius").click();
+    harness.run_steps(2);
+    let generation = harness.state().panes().generations()[0];
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    for key in ["0", ".", "4", "5"] {
+        harness.get_by_role_and_label(Role::SpinButton, "Radius").type_text(key);
+        harness.run_steps(2);
+        assert_eq!(*harness.state().scene(), original, "typing {key} changed the scene before Enter");
+        assert_eq!(harness.state().panes().generations()[0], generation, "typing {key} restarted the pane");
+    }
+    harness.key_press(egui::Key::Enter);
+    harness.run_steps(3);
+    assert_eq!(radius_of(harness.state(), "glass ball"), 0.45);
+    assert_eq!(harness.state().panes().generations()[0], generation + 1, "one restart for the one edit");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(*harness.state().scene(), original, "one undo step");
+}
+
+/// Three wheel notches over a pane dolly the camera over many frames, each
+/// rendered; the gesture is one undo step.
+#[test]
+fn a_dolly_gesture_is_one_undo_step() {
+    let mut harness = studio(1);
+    harness.run_steps(2);
+    let original = harness.state().scene().clone();
+    let centre = harness.state().panes().rects()[0].center();
+    harness.hover_at(centre);
+    harness.run_steps(1);
+    for _ in 0..3 {
+        harness.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Line,
+            delta: egui::vec2(0.0, 1.0),
+            phase: egui::TouchPhase::Move,
+            source: egui::MouseWheelSource::Wheel,
+            modifiers: egui::Modifiers::NONE,
+        });
+        harness.run_steps(1);
+    }
+    // The smooth scroll goes on for a while after the last notch
+    harness.run_steps(8);
+    let dollied = harness.state().scene().camera.position;
+    assert!(dollied.distance(original.camera.position) > 0.1, "the wheel did not dolly: {dollied}");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(*harness.state().scene(), original, "one undo takes back the whole gesture");
+}
+
 #[test]
 fn toggling_a_light_changes_the_scene_and_restarts() {
     let mut harness = studio(1);
@@ -128,12 +187,77 @@ fn four_panes_show_four_algorithms() {
     harness.run_steps(3);
     let app = harness.state();
     assert_eq!(app.panes().count(), 4);
-    let mut algorithms: Vec<_> = app.panes().list().iter().map(|p| p.algorithm()).collect();
-    algorithms.dedup();
-    assert_eq!(algorithms.len(), 4);
-    assert_eq!(algorithms, gi_studio::app::FOUR_PANES.to_vec());
+    let algorithms: Vec<_> = app.panes().list().iter().map(|p| p.algorithm()).collect();
+    assert_eq!(algorithms[0], Algorithm::Path, "the pane there was keeps its algorithm");
+    let mut sorted = algorithms.clone();
+    sorted.sort_by_key(|a| a.name());
+    let mut four = gi_studio::app::FOUR_PANES.to_vec();
+    four.sort_by_key(|a| a.name());
+    assert_eq!(sorted, four, "four different algorithms: {algorithms:?}");
     for pane in 1..=4 {
         harness.get_by_label(&format!("pane {pane}"));
+    }
+}
+
+/// Going from four panes to two keeps the first two panes as they were:
+/// a BDPT and a VCM pane with their settings stay BDPT and VCM.
+#[test]
+fn fewer_panes_keep_their_algorithms_and_settings() {
+    let mut harness = studio(4);
+    for (pane, algorithm) in
+        harness.state_mut().panes_mut().list_mut().iter_mut().zip([Algorithm::Bdpt, Algorithm::Vcm])
+    {
+        pane.settings_mut().method = gi_studio::render::Method::of(algorithm);
+        pane.settings_mut().max_depth = 7;
+    }
+    harness.state_mut().restart_all();
+    harness.run_steps(2);
+    let before: Vec<_> = harness.state().panes().list()[..2].iter().map(|p| p.settings().clone()).collect();
+    harness.get_by_label("View").click();
+    harness.run_steps(2);
+    harness.get_by_label("2 panes").click();
+    harness.run_steps(3);
+    let after = harness.state().panes().list();
+    assert_eq!(after.len(), 2);
+    for (was, pane) in before.iter().zip(after) {
+        assert_eq!(pane.algorithm(), was.algorithm());
+        assert_eq!(pane.settings().method, was.method);
+        assert_eq!(pane.settings().max_depth, 7);
+    }
+}
+
+/// The panes stay where they are while the plots fill with statistics (a
+/// click meant for a pane's menu must not land on the image below it),
+/// and each pane's header stays within its own column, however many
+/// buttons it has.
+#[test]
+fn panes_stay_put_and_headers_stay_in_their_columns() {
+    let mut harness = studio(4);
+    for (pane, algorithm) in
+        harness.state_mut().panes_mut().list_mut().iter_mut().zip([Algorithm::Bdpt, Algorithm::Vcm])
+    {
+        pane.settings_mut().method = gi_studio::render::Method::of(algorithm);
+    }
+    harness.state_mut().restart_all();
+    harness.set_size(egui::vec2(1000.0, 800.0));
+    harness.run_steps(3);
+    let before = harness.state().panes().rects().to_vec();
+    step_until(&mut harness, |app| {
+        app.panes().list().iter().all(|p| p.state().passes() >= 2) && app.panes().list()[2].state().maps.is_some()
+    });
+    harness.run_steps(3);
+    assert_eq!(harness.state().panes().rects(), before.as_slice(), "the panes moved as the plots filled");
+    let area = harness.state().panes().area();
+    let column_width = area.width() / 2.0;
+    for (column, button) in harness.get_all_by_label("Strategies").enumerate() {
+        let left = area.min.x + column as f32 * column_width;
+        let rect = button.rect();
+        assert!(
+            rect.min.x >= left && rect.max.x <= left + column_width,
+            "pane {}'s Strategies button at {rect:?} is outside its column from {left} to {}",
+            column + 1,
+            left + column_width
+        );
     }
 }
 
@@ -193,6 +317,11 @@ fn every_menu_opens_and_draws() {
         harness.get_by_label(menu).click();
         harness.run_steps(2);
         harness.get_by_label_contains(entry);
+        if menu == "Help" {
+            // About names every algorithm there is, Whitted to VCM
+            let all: Vec<&str> = Algorithm::ALL.iter().map(|a| a.label()).collect();
+            harness.get_by_label_contains(&all.join(" · "));
+        }
         harness.key_press(egui::Key::Escape);
         harness.run_steps(2);
     }
@@ -245,24 +374,43 @@ impl eframe::Storage for MemoryStorage {
     fn flush(&mut self) {}
 }
 
+/// What the window does: the studio keeps its state in a file and writes
+/// it as it runs; a crash (the studio never closed: `kill -9`) finds the
+/// layout and the unsaved edit there at the next start, offered back.
 #[test]
 fn layout_is_restored_and_an_unsaved_scene_is_offered_back() {
-    let mut storage = MemoryStorage::default();
+    let folder = tempfile::tempdir().unwrap();
+    let path = folder.path().join("gistudio").join("app.ron");
+    let interval = std::time::Duration::from_millis(50);
     let edited = {
         let args = StudioArgs { panes: Some(2), ..test_args() };
-        let mut app = StudioApp::new(&egui::Context::default(), None, &args);
-        app.edit_scene(|s| s.camera.fov_y_degrees = 55.0);
-        eframe::App::save(&mut app, &mut storage);
-        app.scene().clone()
+        let (file, notice) = StateFile::open(path.clone());
+        assert!(notice.is_none());
+        let mut app = StudioApp::new(&egui::Context::default(), Some(&file), &args);
+        app.keep_state_in(file, interval);
+        let mut harness =
+            Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app);
+        harness.state_mut().edit_scene(|s| s.camera.fov_y_degrees = 55.0);
+        let edited = harness.state().scene().clone();
+        // Frames go on past the interval: the running studio writes the file
+        step_frames_until(&mut harness, 500, |_| {
+            StateFile::open(path.clone()).0.get_string("autosave_scene").is_some_and(|t| !t.is_empty())
+        });
+        // A crash: nothing the studio does at exit happens
+        std::mem::forget(harness);
+        edited
     };
     // Next start: two panes again, and the edit offered back
-    let app = StudioApp::new(&egui::Context::default(), Some(&storage), &test_args());
+    let (file, notice) = StateFile::open(path.clone());
+    assert!(notice.is_none());
+    let app = StudioApp::new(&egui::Context::default(), Some(&file), &test_args());
     assert_eq!(app.panes().count(), 2);
     assert!(app.offers_autosave());
     let mut harness =
         Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app);
     harness.run_steps(2);
     assert_ne!(*harness.state().scene(), edited);
+    harness.get_by_label("Its edits: the camera.");
     harness.get_by_label("Restore").click();
     harness.run_steps(2);
     assert_eq!(*harness.state().scene(), edited);
@@ -303,7 +451,7 @@ fn an_unanswered_autosave_offer_keeps_the_autosave() {
 }
 
 /// A `--screenshot` run (CI's, the README's) saves nothing: not the layout,
-/// not the autosave, whatever it renders.
+/// not the autosave, whatever it renders or shows.
 #[test]
 fn a_screenshot_run_never_touches_the_saved_state() {
     let edited = edited_cornell();
@@ -312,7 +460,7 @@ fn a_screenshot_run_never_touches_the_saved_state() {
     let before = storage.0.clone();
     let args = StudioArgs { screenshot: Some(PathBuf::from("shot.png")), panes: Some(4), ..test_args() };
     let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &args);
-    assert!(!app.offers_autosave());
+    assert!(app.offers_autosave(), "the offer shows as at any start, and stays unanswered");
     app.edit_scene(|s| s.camera.fov_y_degrees = 20.0);
     eframe::App::save(&mut app, &mut storage);
     assert_eq!(storage.0, before);
@@ -430,19 +578,22 @@ fn an_edited_scene_is_measured_against_a_reference_made_in_the_background() {
     assert_eq!(kept(cache.path()), 1, "nothing rendered again");
 }
 
-/// A BDPT pane's "Strategies" button opens the strategy view, which fills
-/// with every strategy's image as passes arrive, each told with its share
-/// of the pane's light; closing it renders without them again.
+/// A BDPT pane's "Strategies" button opens the strategy view without
+/// restarting the pane; the view fills with every strategy's image as
+/// passes arrive, each told with its share of the pane's light; closing it
+/// renders without them again.
 #[test]
 fn the_strategy_view_shows_each_strategy_with_its_share() {
     let mut harness = studio(1);
     let pane = &mut harness.state_mut().panes_mut().list_mut()[0];
     pane.settings_mut().method = gi_studio::render::Method::of(gi_studio::render::Algorithm::Bdpt);
-    pane.settings_mut().samples_per_pixel = Some(8);
+    pane.settings_mut().samples_per_pixel = Some(4096);
     harness.state_mut().restart_all();
-    harness.run_steps(2);
+    step_until(&mut harness, |app| app.panes().list()[0].state().passes() >= 1);
+    let generation = harness.state().panes().generations()[0];
     harness.get_by_label("Strategies").click();
     harness.run_steps(1);
+    assert_eq!(harness.state().panes().generations()[0], generation, "opening the view restarted the pane");
     step_until(&mut harness, |app| app.panes().list()[0].state().strategies.as_ref().is_some_and(|s| s.passes >= 2));
     harness.run_steps(2);
     let cell = harness.get_by_label_contains("(s, t) = (1, 2): ");

@@ -8,6 +8,7 @@ use eframe::egui;
 
 use super::commands::{Action, Command};
 use super::files::{file_dialog_ui, DialogPurpose, FileDialog};
+use super::storage::AutosaveOffer;
 use crate::scene::Scene;
 
 #[derive(Default)]
@@ -18,25 +19,32 @@ pub struct Dialogs {
     /// What would discard unsaved edits, waiting for the user's answer.
     pending: Option<Action>,
     /// The last session's unsaved scene, offered back.
-    autosave_offer: Option<Scene>,
+    autosave_offer: Option<AutosaveOffer>,
+    /// Where new files are suggested: the folder last used.
+    folder: PathBuf,
 }
 
 impl Dialogs {
-    pub fn new(autosave_offer: Option<Scene>) -> Self {
-        Self { autosave_offer, ..Self::default() }
+    /// `folder`: where files are suggested until one is chosen.
+    pub fn new(autosave_offer: Option<AutosaveOffer>, folder: PathBuf) -> Self {
+        Self { autosave_offer, folder, ..Self::default() }
     }
 
     /// The file dialog for `purpose`, suggesting the document's own file
-    /// (`scene_path`) or a name that says what it is for.
+    /// (`scene_path`) or, in the folder last used, a name that says what it
+    /// is for.
     pub fn open_file(&mut self, purpose: DialogPurpose, scene_path: Option<&Path>) {
+        let in_folder = |name: &str| self.folder.join(name);
         let suggestion = match purpose {
             DialogPurpose::OpenScene | DialogPurpose::SaveScene => {
-                scene_path.map_or_else(|| PathBuf::from("assets/scenes/untitled.ron"), Path::to_owned)
+                scene_path.map_or_else(|| in_folder("untitled.ron"), Path::to_owned)
             }
-            DialogPurpose::ExportPng => PathBuf::from("render.png"),
-            DialogPurpose::ExportExr => PathBuf::from("render.exr"),
-            DialogPurpose::Screenshot => PathBuf::from("screenshot.png"),
-            DialogPurpose::ComparisonSheet => PathBuf::from("comparison.png"),
+            DialogPurpose::ExportImage { pane, algorithm, exr } => {
+                let extension = if exr { "exr" } else { "png" };
+                in_folder(&format!("pane{}-{}.{extension}", pane + 1, algorithm.name()))
+            }
+            DialogPurpose::Screenshot => in_folder("screenshot.png"),
+            DialogPurpose::ComparisonSheet => in_folder("comparison.png"),
         };
         self.file = Some(FileDialog::new(purpose, &suggestion));
     }
@@ -49,9 +57,14 @@ impl Dialogs {
         self.autosave_offer.is_some()
     }
 
+    /// What the offered scene's edits are, while it is offered.
+    pub fn offered_edits(&self) -> Option<&[String]> {
+        self.autosave_offer.as_ref().map(|offer| offer.edits.as_slice())
+    }
+
     /// The offered scene, taken (the offer is answered).
     pub fn take_autosave(&mut self) -> Option<Scene> {
-        self.autosave_offer.take()
+        self.autosave_offer.take().map(|offer| offer.scene)
     }
 
     /// Draw what is open; the user's answers go to `commands`.
@@ -63,6 +76,9 @@ impl Dialogs {
                 self.file = None;
             }
             if let Some(path) = chosen {
+                if let Some(folder) = path.parent().filter(|f| !f.as_os_str().is_empty()) {
+                    self.folder = folder.to_owned();
+                }
                 // Writing over another file is the user's call, asked once
                 let own_file = purpose == DialogPurpose::SaveScene && scene_path == Some(path.as_path());
                 if purpose != DialogPurpose::OpenScene && path.exists() && !own_file {
@@ -104,9 +120,10 @@ impl Dialogs {
                 });
             });
         }
-        if self.autosave_offer.is_some() {
+        if let Some(offer) = &self.autosave_offer {
             egui::Window::new("Restore unsaved scene?").collapsible(false).resizable(false).show(ctx, |ui| {
                 ui.label("The last session ended with unsaved edits. Restore that scene?");
+                ui.label(format!("Its edits: {}.", offer.edits.join(", ")));
                 ui.horizontal(|ui| {
                     if ui.button("Restore").clicked() {
                         commands.push(Command::RestoreAutosave);

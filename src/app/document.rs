@@ -68,6 +68,11 @@ impl Document {
         &mut self.scene
     }
 
+    /// The revision of the scene as it stands (a new one at every edit).
+    pub fn revision(&self) -> u64 {
+        self.revision
+    }
+
     /// The scene was edited: a new revision.
     pub fn changed(&mut self) {
         self.revision = self.next_revision;

@@ -5,25 +5,33 @@ use std::path::{Path, PathBuf};
 
 use eframe::egui;
 
+use crate::render::Algorithm;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DialogPurpose {
     OpenScene,
     SaveScene,
-    ExportPng,
-    ExportExr,
+    /// Pane `pane`'s image, made by `algorithm`, as PNG (display) or EXR (linear).
+    ExportImage {
+        pane: usize,
+        algorithm: Algorithm,
+        exr: bool,
+    },
     Screenshot,
     ComparisonSheet,
 }
 
 impl DialogPurpose {
-    fn title(self) -> &'static str {
+    fn title(self) -> String {
         match self {
-            DialogPurpose::OpenScene => "Open scene",
-            DialogPurpose::SaveScene => "Save scene as",
-            DialogPurpose::ExportPng => "Export image (PNG)",
-            DialogPurpose::ExportExr => "Export image (EXR, linear)",
-            DialogPurpose::Screenshot => "Save window screenshot (PNG)",
-            DialogPurpose::ComparisonSheet => "Export comparison sheet (PNG)",
+            DialogPurpose::OpenScene => "Open scene".into(),
+            DialogPurpose::SaveScene => "Save scene as".into(),
+            DialogPurpose::ExportImage { pane, algorithm, exr } => {
+                let format = if exr { "EXR, linear" } else { "PNG" };
+                format!("Export pane {}'s image ({}) as {format}", pane + 1, algorithm.label())
+            }
+            DialogPurpose::Screenshot => "Save window screenshot (PNG)".into(),
+            DialogPurpose::ComparisonSheet => "Export comparison sheet (PNG)".into(),
         }
     }
 }

@@ -6,9 +6,11 @@
 use eframe::egui;
 use glam::Vec3;
 
+use super::widgets::{committed_text_ui, number, slider};
+
 use crate::scene::{Attenuation, ClipAlong, Invalid, Light, LightKind, Material, MaterialModel, Object, Scene, Shape};
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Selection {
     #[default]
     Camera,
@@ -198,8 +200,7 @@ fn vec3_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f64) -> bool {
         let label = ui.label(label);
         let mut changed = false;
         for (axis, c) in ["x", "y", "z"].into_iter().zip([&mut v.x, &mut v.y, &mut v.z]) {
-            changed |=
-                ui.add(egui::DragValue::new(c).speed(speed).prefix(format!("{axis} "))).labelled_by(label.id).changed();
+            changed |= ui.add(number(c).speed(speed).prefix(format!("{axis} "))).labelled_by(label.id).changed();
         }
         changed
     })
@@ -209,7 +210,7 @@ fn vec3_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f64) -> bool {
 fn scalar_ui(ui: &mut egui::Ui, label: &str, v: &mut f32, range: std::ops::RangeInclusive<f32>, speed: f64) -> bool {
     ui.horizontal(|ui| {
         let label = ui.label(label);
-        ui.add(egui::DragValue::new(v).speed(speed).range(range)).labelled_by(label.id).changed()
+        ui.add(number(v).speed(speed).range(range)).labelled_by(label.id).changed()
     })
     .inner
 }
@@ -225,7 +226,7 @@ fn reflectance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) -> bool {
             changed = true;
         }
         for c in [&mut v.x, &mut v.y, &mut v.z] {
-            changed |= ui.add(egui::DragValue::new(c).speed(0.005).range(0.0..=1.0)).labelled_by(label.id).changed();
+            changed |= ui.add(number(c).speed(0.005).range(0.0..=1.0)).labelled_by(label.id).changed();
         }
         changed
     })
@@ -238,8 +239,7 @@ fn radiance_ui(ui: &mut egui::Ui, label: &str, v: &mut Vec3) -> bool {
         let label = ui.label(label);
         let mut changed = false;
         for c in [&mut v.x, &mut v.y, &mut v.z] {
-            changed |=
-                ui.add(egui::DragValue::new(c).speed(0.05).range(0.0..=f32::MAX)).labelled_by(label.id).changed();
+            changed |= ui.add(number(c).speed(0.05).range(0.0..=f32::MAX)).labelled_by(label.id).changed();
         }
         changed
     })
@@ -254,8 +254,7 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
             changed |= vec3_ui(ui, "Position", &mut camera.position, 0.01);
             changed |= vec3_ui(ui, "Look at", &mut camera.look_at, 0.01);
             changed |= vec3_ui(ui, "Up", &mut camera.up, 0.01);
-            changed |=
-                ui.add(egui::Slider::new(&mut camera.fov_y_degrees, 1.0..=170.0).text("Field of view °")).changed();
+            changed |= ui.add(slider(&mut camera.fov_y_degrees, 1.0..=170.0).text("Field of view °")).changed();
             changed |= scalar_ui(ui, "Near clip", &mut camera.near_clip, 0.0..=f32::MAX, 0.01);
             ui.horizontal(|ui| {
                 ui.label("measured along");
@@ -270,7 +269,7 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
         Selection::Object(i) => {
             let names: Vec<String> = scene.materials.iter().map(|m| m.name.clone()).collect();
             let Some(object) = scene.objects.get_mut(i) else { return false };
-            changed |= name_ui(ui, &mut object.name);
+            changed |= name_ui(ui, &mut object.name, *selection);
             egui::ComboBox::from_label("Material").selected_text(object.material.clone()).show_ui(ui, |ui| {
                 for name in names {
                     changed |= ui.selectable_value(&mut object.material, name.clone(), name).changed();
@@ -282,7 +281,7 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
                     changed |= ui
                         .horizontal(|ui| {
                             let label = ui.label("Radius");
-                            let drag = egui::DragValue::new(radius).speed(0.01).range(1e-6..=f32::MAX);
+                            let drag = number(radius).speed(0.01).range(1e-6..=f32::MAX);
                             ui.add(drag).labelled_by(label.id).changed()
                         })
                         .inner;
@@ -301,7 +300,7 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
         Selection::Material(i) => {
             let Some(material) = scene.materials.get_mut(i) else { return false };
             let old_name = material.name.clone();
-            changed |= name_ui(ui, &mut material.name);
+            changed |= name_ui(ui, &mut material.name, *selection);
             changed |= material_model_ui(ui, &mut material.model);
             // Renaming a material keeps its objects pointing at it
             let new_name = material.name.clone();
@@ -313,7 +312,7 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
         }
         Selection::Light(i) => {
             let Some(light) = scene.lights.get_mut(i) else { return false };
-            changed |= name_ui(ui, &mut light.name);
+            changed |= name_ui(ui, &mut light.name, *selection);
             changed |= ui.checkbox(&mut light.enabled, "Enabled").changed();
             changed |= light_kind_ui(ui, &mut light.kind);
             changed |= reflectance_ui(ui, "Colour", &mut light.color);
@@ -323,8 +322,7 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
                 ui.horizontal(|ui| {
                     let a = &mut light.attenuation;
                     for (label, v) in [("a", &mut a.a), ("b", &mut a.b), ("c", &mut a.c)] {
-                        let drag =
-                            egui::DragValue::new(v).speed(0.01).range(0.0..=f32::MAX).prefix(format!("{label} "));
+                        let drag = number(v).speed(0.01).range(0.0..=f32::MAX).prefix(format!("{label} "));
                         changed |= ui.add(drag).labelled_by(heading.id).changed();
                     }
                 });
@@ -334,10 +332,12 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
     changed
 }
 
-fn name_ui(ui: &mut egui::Ui, name: &mut String) -> bool {
+fn name_ui(ui: &mut egui::Ui, name: &mut String, selection: Selection) -> bool {
     ui.horizontal(|ui| {
-        ui.label("Name");
-        ui.text_edit_singleline(name).changed()
+        let label = ui.label("Name");
+        let edit = committed_text_ui(ui, name, selection);
+        edit.response.labelled_by(label.id);
+        edit.inner
     })
     .inner
 }
@@ -375,12 +375,12 @@ fn material_model_ui(ui: &mut egui::Ui, model: &mut MaterialModel) -> bool {
                 let mut changed = reflectance_ui(ui, "ka", ka);
                 changed |= reflectance_ui(ui, "kd", kd);
                 changed |= reflectance_ui(ui, "ks", ks);
-                let slider = egui::Slider::new(shininess, 0.0..=2000.0).logarithmic(true).text("Shininess");
+                let slider = slider(shininess, 0.0..=2000.0).logarithmic(true).text("Shininess");
                 changed | ui.add(slider).changed()
             }
             MaterialModel::Mirror { tint } => reflectance_ui(ui, "Tint", tint),
             MaterialModel::Glass { ior, tint } => {
-                let changed = ui.add(egui::Slider::new(ior, 1.0..=3.0).text("Index of refraction")).changed();
+                let changed = ui.add(slider(ior, 1.0..=3.0).text("Index of refraction")).changed();
                 changed | reflectance_ui(ui, "Tint", tint)
             }
             MaterialModel::Emissive { radiance } => radiance_ui(ui, "Radiance", radiance),
@@ -416,9 +416,8 @@ fn light_kind_ui(ui: &mut egui::Ui, kind: &mut LightKind) -> bool {
             LightKind::Spot { position, direction, cone_angle_degrees, falloff_exponent } => {
                 let mut changed = vec3_ui(ui, "Position", position, 0.01);
                 changed |= vec3_ui(ui, "Direction", direction, 0.01);
-                changed |=
-                    ui.add(egui::Slider::new(cone_angle_degrees, 0.1..=90.0).text("Cone half-angle °")).changed();
-                let falloff = egui::Slider::new(falloff_exponent, 0.0..=10_000.0).logarithmic(true);
+                changed |= ui.add(slider(cone_angle_degrees, 0.1..=90.0).text("Cone half-angle °")).changed();
+                let falloff = slider(falloff_exponent, 0.0..=10_000.0).logarithmic(true);
                 changed | ui.add(falloff.text("Falloff exponent")).changed()
             }
         }

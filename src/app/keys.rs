@@ -37,3 +37,32 @@ pub struct WindowState {
     pub close_requested: bool,
     pub minimised: bool,
 }
+
+/// Seconds between wheel notches that still belong to one gesture.
+const WHEEL_GESTURE_GAP: f64 = 0.5;
+
+/// Whether the user is in the middle of a gesture: a button held (a drag),
+/// or the wheel turned within the last half second (a dolly of several
+/// notches, which egui spreads over many frames).
+#[derive(Default)]
+pub struct Gesture {
+    last_wheel: Option<f64>,
+}
+
+impl Gesture {
+    pub fn interacting(&mut self, ctx: &egui::Context) -> bool {
+        let (now, wheel, held) = ctx.input(|i| {
+            let wheel = i.is_scrolling() || i.smooth_scroll_delta != egui::Vec2::ZERO;
+            (i.time, wheel, i.pointer.any_down())
+        });
+        if wheel {
+            self.last_wheel = Some(now);
+        }
+        let turning = self.last_wheel.is_some_and(|at| now - at < WHEEL_GESTURE_GAP);
+        if turning {
+            // The gesture ends with no input to say so: a frame when it has
+            ctx.request_repaint_after(std::time::Duration::from_secs_f64(WHEEL_GESTURE_GAP));
+        }
+        held || turning
+    }
+}

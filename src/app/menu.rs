@@ -7,6 +7,7 @@ use eframe::egui;
 
 use super::commands::{Action, Command, Panel, Shown};
 use super::files::DialogPurpose;
+use crate::render::Algorithm;
 use crate::scene::presets;
 
 /// What the menus show.
@@ -14,7 +15,8 @@ pub struct MenuView<'a> {
     pub can_undo: bool,
     pub can_redo: bool,
     pub recent: &'a [PathBuf],
-    pub panes: usize,
+    /// Each pane's algorithm, in order.
+    pub panes: Vec<Algorithm>,
     pub shown: Shown,
     /// The document's file, and whether it has unsaved edits.
     pub file: Option<(&'a Path, bool)>,
@@ -36,7 +38,7 @@ pub fn menu_bar_ui(ui: &mut egui::Ui, view: &MenuView, commands: &mut Vec<Comman
         ui.menu_button("View", |ui| {
             for count in [1, 2, 4] {
                 let label = format!("{count} pane{}", if count == 1 { "" } else { "s" });
-                if ui.radio(view.panes == count, label).clicked() {
+                if ui.radio(view.panes.len() == count, label).clicked() {
                     commands.push(Command::SetPanes(count));
                     ui.close();
                 }
@@ -58,7 +60,9 @@ pub fn menu_bar_ui(ui: &mut egui::Ui, view: &MenuView, commands: &mut Vec<Comman
             ui.label("Ctrl+Z / Ctrl+Shift+Z: undo / redo · Ctrl+S: save · Ctrl+O: open");
             ui.label("Drop a .ron file on the window to open it.");
             ui.separator();
-            ui.label(format!("GI Studio {} — Whitted, path tracing, photon mapping, SPPM", env!("CARGO_PKG_VERSION")));
+            let algorithms: Vec<&str> = Algorithm::ALL.iter().map(|a| a.label()).collect();
+            ui.label(format!("GI Studio {}", env!("CARGO_PKG_VERSION")));
+            ui.label(algorithms.join(" · "));
         });
         if let Some((path, dirty)) = view.file {
             ui.separator();
@@ -99,11 +103,16 @@ fn file_menu_ui(ui: &mut egui::Ui, view: &MenuView, commands: &mut Vec<Command>)
         choose(ui, Command::OpenDialog(DialogPurpose::SaveScene));
     }
     ui.menu_button("Export image", |ui| {
-        if ui.button("PNG (display)…").clicked() {
-            choose(ui, Command::OpenDialog(DialogPurpose::ExportPng));
-        }
-        if ui.button("EXR (linear)…").clicked() {
-            choose(ui, Command::OpenDialog(DialogPurpose::ExportExr));
+        for (pane, &algorithm) in view.panes.iter().enumerate() {
+            ui.label(format!("Pane {}: {}", pane + 1, algorithm.label()));
+            ui.horizontal(|ui| {
+                for (label, exr) in [("PNG (display)…", false), ("EXR (linear)…", true)] {
+                    let button = ui.button(label).on_hover_text(format!("Pane {}'s image as {label}", pane + 1));
+                    if button.clicked() {
+                        choose(ui, Command::OpenDialog(DialogPurpose::ExportImage { pane, algorithm, exr }));
+                    }
+                }
+            });
         }
     });
     if ui.button("Save window screenshot…").clicked() {

@@ -24,6 +24,8 @@ mod storage;
 mod strategies;
 mod studio;
 mod viewport;
+mod widgets;
+mod window_lost;
 
 pub use commands::Action;
 pub use inspector::Selection;
@@ -31,7 +33,7 @@ pub use pane::{Pane, PaneError, PaneState, PassRecord};
 pub use panes::{Panes, FOUR as FOUR_PANES};
 pub use references::{Progress, References, Source};
 pub use status::Messages;
-pub use storage::Persisted;
+pub use storage::{Persisted, StateFile, SAVE_INTERVAL};
 pub use studio::StudioApp;
 
 use std::path::PathBuf;
@@ -92,20 +94,31 @@ pub fn run(args: StudioArgs) -> anyhow::Result<()> {
         None => (None, None),
     };
     let mut exit_error = None;
-    eframe::run_native(
-        "GI Studio",
-        options,
-        Box::new(|cc| {
-            let mut app = StudioApp::new(&cc.egui_ctx, state.as_ref().map(|s| s as &dyn eframe::Storage), &args);
-            app.notice(&notice.unwrap_or_default());
-            if let Some(file) = state {
-                app.keep_state_in(file);
-            }
-            exit_error = Some(app.exit_error());
-            Ok(Box::new(app))
-        }),
-    )
-    .map_err(|e| anyhow::anyhow!("could not open the studio window: {e}"))?;
+    let window = window_lost::catching_window_loss(|| {
+        eframe::run_native(
+            "GI Studio",
+            options,
+            Box::new(|cc| {
+                let mut app = StudioApp::new(&cc.egui_ctx, state.as_ref().map(|s| s as &dyn eframe::Storage), &args);
+                app.notice(&notice.unwrap_or_default());
+                // A scene that would not open (`--scene`) is said where the
+                // command was typed too, not only in the status bar
+                if let Some(error) = &app.messages().error {
+                    eprintln!("error: {error}");
+                }
+                if let Some(file) = state {
+                    app.keep_state_in(file, storage::SAVE_INTERVAL);
+                }
+                exit_error = Some(app.exit_error());
+                Ok(Box::new(app))
+            }),
+        )
+    });
+    match window {
+        Ok(opened) => opened.map_err(|e| anyhow::anyhow!("could not open the studio window: {e}"))?,
+        // A window taken away is closed: the studio wrote its state as it went
+        Err(lost) => eprintln!("The window system destroyed the window ({}); the studio closed.", lost.0),
+    }
     if let Some(message) = exit_error.and_then(|slot| slot.lock().ok().and_then(|mut m| m.take())) {
         anyhow::bail!(message);
     }

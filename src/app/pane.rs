@@ -9,6 +9,7 @@ use std::time::Duration;
 use eframe::egui;
 
 use super::strategies::{strategies_ui, StrategyView};
+use super::widgets::{number, slider};
 use crate::analysis::metrics::{rel_mse_against, ErrorEstimate};
 use crate::analysis::reference::{Reference, REFERENCE_PASSES};
 use crate::limits;
@@ -19,7 +20,7 @@ use crate::render::integrators::photon_map::PhotonMapStats;
 use crate::render::world::camera::TileRect;
 use crate::render::{
     Algorithm, LinearImage, Method, MisHeuristic, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings,
-    Workers,
+    Switch, Workers,
 };
 use crate::scene::ValidScene;
 
@@ -206,6 +207,8 @@ pub struct Pane {
     session: Option<RenderSession>,
     texture: Option<egui::TextureHandle>,
     strategy_view: StrategyView,
+    /// On while the strategy view is open; every job of the pane reads it.
+    strategies: Switch,
 }
 
 impl Pane {
@@ -226,7 +229,8 @@ impl Pane {
                 None
             }
         };
-        Self { state, settings, exposure, session, texture: None, strategy_view: StrategyView::default() }
+        let (strategy_view, strategies) = (StrategyView::default(), Switch::default());
+        Self { state, settings, exposure, session, texture: None, strategy_view, strategies }
     }
 
     pub fn settings(&self) -> &RenderSettings {
@@ -265,12 +269,21 @@ impl Pane {
         let pane_light = (light[0] + light[1] + light[2]) / 3.0;
         let images = self.state.strategies.clone();
         strategies_ui(ctx, index, &mut self.strategy_view, images, self.exposure, pane_light);
+        // Its window may have been closed
+        self.strategies.set(self.strategy_view.open);
+    }
+
+    /// Open or close the strategy view: the job going on counts each
+    /// strategy from its next pass, or stops counting (no restart).
+    pub fn show_strategies(&mut self, open: bool) {
+        self.strategy_view.open = open;
+        self.strategies.set(open);
     }
 
     /// Abandon the current job and render `scene` afresh (never waits).
     pub fn restart(&mut self, scene: Arc<ValidScene>) {
         let Some(session) = &self.session else { return };
-        let strategies = self.strategy_view.open && self.has_strategies();
+        let strategies = self.strategies.clone();
         let job = RenderJob { estimate_noise: true, strategies, ..RenderJob::new(scene, self.settings.clone()) };
         let generation = session.start(job);
         self.state = PaneState::new(generation, self.settings.width, self.settings.height);
@@ -396,16 +409,16 @@ impl Pane {
         // The engine's limits, narrowed where a pane cannot use more
         let range = |limit: limits::Limit<u32>| limit.min..=limit.max;
         let mut spp = s.samples_per_pixel.unwrap_or(0);
-        let target = egui::DragValue::new(&mut spp).range(0..=limits::SAMPLES_PER_PIXEL.max);
+        let target = number(&mut spp).range(0..=limits::SAMPLES_PER_PIXEL.max);
         ui.add(target.prefix("spp target (0: none) "));
         s.samples_per_pixel = (spp > 0).then_some(spp);
         let mut budget = s.time_limit.unwrap_or(0.0);
-        let time = egui::DragValue::new(&mut budget).range(0.0..=limits::SECONDS.max).speed(0.5);
+        let time = number(&mut budget).range(0.0..=limits::SECONDS.max).speed(0.5);
         ui.add(time.prefix("time budget s (0: none) "));
         s.time_limit = (budget > 0.0).then_some(budget);
-        ui.add(egui::DragValue::new(&mut s.max_depth).range(range(limits::MAX_DEPTH)).prefix("max depth "));
-        ui.add(egui::DragValue::new(&mut s.width).range(16..=4096).prefix("width "));
-        ui.add(egui::DragValue::new(&mut s.height).range(16..=4096).prefix("height "));
+        ui.add(number(&mut s.max_depth).range(range(limits::MAX_DEPTH)).prefix("max depth "));
+        ui.add(number(&mut s.width).range(16..=4096).prefix("width "));
+        ui.add(number(&mut s.height).range(16..=4096).prefix("height "));
         let mis_ui = |ui: &mut egui::Ui, mis: &mut MisHeuristic| {
             ui.horizontal(|ui| {
                 ui.label("MIS");
@@ -423,9 +436,9 @@ impl Pane {
             Method::Bpm(m) | Method::Vcm(m) => {
                 ui.separator();
                 mis_ui(ui, &mut m.mis);
-                let radius = egui::DragValue::new(&mut m.radius).range(0.0..=1e6).speed(0.001);
+                let radius = number(&mut m.radius).range(0.0..=1e6).speed(0.001);
                 ui.add(radius.prefix("merge radius (0: auto) "));
-                ui.add(egui::Slider::new(&mut m.alpha, 0.05..=1.0).text("α"));
+                ui.add(slider(&mut m.alpha, 0.05..=1.0).text("α"));
                 if vcm {
                     let caustics = ui.checkbox(&mut m.caustic_merges, "merge caustic paths only");
                     caustics.on_hover_text(
@@ -436,27 +449,27 @@ impl Pane {
             Method::Photon(p) => {
                 ui.separator();
                 let photons = range(limits::PHOTONS);
-                let global = egui::DragValue::new(&mut p.global_photons).range(photons.clone()).speed(1000);
+                let global = number(&mut p.global_photons).range(photons.clone()).speed(1000);
                 ui.add(global.prefix("global photons "));
-                let caustic = egui::DragValue::new(&mut p.caustic_photons).range(photons).speed(1000);
+                let caustic = number(&mut p.caustic_photons).range(photons).speed(1000);
                 ui.add(caustic.prefix("caustic photons "));
-                ui.add(egui::DragValue::new(&mut p.k_nearest).range(8..=1000).prefix("k nearest "));
-                let radius = egui::DragValue::new(&mut p.max_radius).range(0.0..=1e6).speed(0.001);
+                ui.add(number(&mut p.k_nearest).range(8..=1000).prefix("k nearest "));
+                let radius = number(&mut p.max_radius).range(0.0..=1e6).speed(0.001);
                 ui.add(radius.prefix("max radius (0: auto) "));
                 ui.checkbox(&mut p.final_gather, "final gather");
-                ui.add(egui::DragValue::new(&mut p.final_gather_rays).range(1..=1024).prefix("gather rays "));
+                ui.add(number(&mut p.final_gather_rays).range(1..=1024).prefix("gather rays "));
             }
             Method::Sppm(p) => {
                 ui.separator();
-                let photons = egui::DragValue::new(&mut p.photons_per_pass).range(range(limits::SPPM_PHOTONS));
+                let photons = number(&mut p.photons_per_pass).range(range(limits::SPPM_PHOTONS));
                 ui.add(photons.speed(1000).prefix("photons per pass "));
-                let radius = egui::DragValue::new(&mut p.initial_radius).range(0.0..=1e6).speed(0.001);
+                let radius = number(&mut p.initial_radius).range(0.0..=1e6).speed(0.001);
                 ui.add(radius.prefix("initial radius (0: auto) "));
-                ui.add(egui::Slider::new(&mut p.alpha, 0.05..=1.0).text("α"));
+                ui.add(slider(&mut p.alpha, 0.05..=1.0).text("α"));
             }
         }
         ui.separator();
-        if ui.add(egui::Slider::new(&mut self.exposure, -8.0..=8.0).text("exposure (stops)")).changed() {
+        if ui.add(slider(&mut self.exposure, -8.0..=8.0).text("exposure (stops)")).changed() {
             self.refresh_texture();
         }
         self.settings != before

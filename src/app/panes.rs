@@ -67,15 +67,17 @@ impl Panes {
 
     /// `count` panes, pane i with `saved[i]` (its defaults where None or
     /// missing) and `exposures[i]` (the scene's where missing).
+    /// A pane without saved settings gets the first of the layout's default
+    /// algorithms that no saved pane has.
     pub fn build(&mut self, count: usize, saved: &[Option<RenderSettings>], exposures: &[f32], scene: &SceneSettings) {
-        let algorithms = default_algorithms(count);
+        let taken: Vec<Algorithm> = saved.iter().take(count).flatten().map(RenderSettings::algorithm).collect();
+        let mut spare = default_algorithms(count).into_iter().filter(|a| !taken.contains(a));
         self.list = (0..count)
             .map(|i| {
-                let settings = saved
-                    .get(i)
-                    .cloned()
-                    .flatten()
-                    .unwrap_or_else(|| Self::default_settings(algorithms[i], count, scene));
+                let settings = match saved.get(i).cloned().flatten() {
+                    Some(settings) => settings,
+                    None => Self::default_settings(spare.next().unwrap_or(Algorithm::Path), count, scene),
+                };
                 let exposure = exposures.get(i).copied().unwrap_or(scene.exposure);
                 Pane::new(&self.ctx, self.workers.as_ref(), settings, exposure)
             })
@@ -86,13 +88,27 @@ impl Panes {
     /// The same panes for a new scene: its size and exposure for every one.
     pub fn rebuild_for(&mut self, scene: &SceneSettings) {
         let count = self.list.len();
-        let saved: Vec<Option<RenderSettings>> = (self.list.iter())
+        let kept = self.kept_settings(count, scene);
+        self.build(count, &kept, &vec![scene.exposure; count], scene);
+    }
+
+    /// `count` panes in place of these: the first keep their algorithms,
+    /// settings and exposures (at the new layout's size), new ones come
+    /// with their defaults.
+    pub fn set_count(&mut self, count: usize, scene: &SceneSettings) {
+        let kept = self.kept_settings(count, scene);
+        let exposures: Vec<f32> = self.list.iter().take(count).map(Pane::exposure).collect();
+        self.build(count, &kept, &exposures, scene);
+    }
+
+    /// The first `count` panes' settings, sized for `count` panes of `scene`.
+    fn kept_settings(&self, count: usize, scene: &SceneSettings) -> Vec<Option<RenderSettings>> {
+        (self.list.iter().take(count))
             .map(|p| {
                 let sized = Self::default_settings(p.algorithm(), count, scene);
                 Some(RenderSettings { width: sized.width, height: sized.height, ..p.settings().clone() })
             })
-            .collect();
-        self.build(count, &saved, &vec![scene.exposure; count], scene);
+            .collect()
     }
 
     pub fn count(&self) -> usize {
@@ -175,18 +191,19 @@ impl Panes {
     ) -> (egui::Rect, bool) {
         let pane = &mut self.list[index];
         let (mut restart, mut promote) = (false, false);
-        ui.horizontal(|ui| {
+        // Wrapped within the pane's own width: a row that ran on would put
+        // its last buttons in the next pane's header
+        ui.horizontal_wrapped(|ui| {
             restart |= pane.algorithm_ui(ui, index);
             ui.menu_button("Settings", |ui| restart |= pane.settings_ui(ui));
             restart |= ui.small_button("Restart").on_hover_text("Restart this pane").clicked();
             let hint = "Measure every pane against this pane's image from now on";
             promote |= ui.small_button("Use as reference").on_hover_text(hint).clicked();
             if pane.has_strategies() {
-                let view = pane.strategy_view_mut();
-                let hint = "What each way of joining light and camera paths brings to this pane";
-                if ui.selectable_label(view.open, "Strategies").on_hover_text(hint).clicked() {
-                    view.open = !view.open;
-                    restart = true;
+                let open = pane.strategy_view_mut().open;
+                let hint = "What each way of joining light and camera paths brings to this pane, from the next pass";
+                if ui.selectable_label(open, "Strategies").on_hover_text(hint).clicked() {
+                    pane.show_strategies(!open);
                 }
             }
         });

@@ -8,9 +8,10 @@ use super::pane::{Pane, PaneError};
 use crate::render::integrators::photon_map::maps::RADIUS_BINS;
 use crate::render::integrators::SppmTimes;
 
-pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane]) {
-    // A fixed height: plots asking for all the space would push the panes out
-    let height = 150.0;
+/// The plots in a panel `panel_height` high.
+pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane], panel_height: f32) {
+    // Room for the titles above the plots (two lines, where they wrap)
+    let height = (panel_height - 2.5 * ui.text_style_height(&egui::TextStyle::Body)).max(60.0);
     ui.columns(4, |columns| {
         columns[0].label("Time per pass (ms)");
         Plot::new("pass_time").legend(Legend::default()).height(height).show(&mut columns[0], |plot| {

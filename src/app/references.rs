@@ -13,6 +13,8 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender};
 use eframe::egui;
 
+use super::widgets::number;
+
 use crate::analysis::reference::{
     embedded, reference_key, reference_method, reference_settings, reference_size, Reference, ReferenceCache,
     ReferenceInfo, ReferenceMethod,
@@ -417,7 +419,7 @@ impl References {
             ui.label(self.describe());
             let mut threads = self.threads;
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-            let slider = egui::DragValue::new(&mut threads).range(1..=cores.max(1)).prefix("reference threads ");
+            let slider = number(&mut threads).range(1..=cores.max(1)).prefix("reference threads ");
             if ui.add(slider).on_hover_text("Threads that render a reference in the background").changed() {
                 self.set_threads(threads);
             }

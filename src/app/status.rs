@@ -104,10 +104,14 @@ impl Messages {
         self.status += message;
     }
 
-    /// Say `done` if `result` went well, its error otherwise.
+    /// Say `done` if `result` went well (an error from an earlier try
+    /// is over), its error otherwise.
     pub fn report<E: ToString>(&mut self, result: Result<(), E>, done: impl FnOnce() -> String) {
         match result {
-            Ok(()) => self.say(done()),
+            Ok(()) => {
+                self.error = None;
+                self.say(done());
+            }
             Err(e) => self.fail(e),
         }
     }

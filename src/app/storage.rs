@@ -138,10 +138,17 @@ impl StateFile {
         &self.path
     }
 
+    /// The state as the file holds it.
+    pub fn text(&self) -> Result<String, String> {
+        ron::ser::to_string_pretty(&self.values, ron::ser::PrettyConfig::new()).map_err(|e| e.to_string())
+    }
+
     /// Write the state, atomically.
     pub fn write(&self) -> Result<(), String> {
-        let text =
-            ron::ser::to_string_pretty(&self.values, ron::ser::PrettyConfig::new()).map_err(|e| e.to_string())?;
+        self.write_text(&self.text()?)
+    }
+
+    fn write_text(&self, text: &str) -> Result<(), String> {
         if let Some(folder) = self.path.parent() {
             std::fs::create_dir_all(folder).map_err(|e| format!("{}: {e}", folder.display()))?;
         }
@@ -169,7 +176,8 @@ impl eframe::Storage for StateFile {
 /// The two keys of the studio's state.
 const STATE_KEY: &str = "studio";
 const AUTOSAVE_KEY: &str = "autosave_scene";
-const SAVE_INTERVAL: std::time::Duration = std::time::Duration::from_secs(10);
+/// How often the studio writes its state while it runs.
+pub const SAVE_INTERVAL: std::time::Duration = std::time::Duration::from_secs(10);
 
 /// What the autosave should hold after a save.
 pub enum Autosave {
@@ -188,11 +196,20 @@ pub fn read_state(storage: Option<&dyn eframe::Storage>) -> (Restored, Option<St
     (persisted.restore(), autosave)
 }
 
+/// A crashed session's unsaved scene, offered back.
+pub struct AutosaveOffer {
+    pub scene: Scene,
+    /// What it has that the scene the studio opened on has not.
+    pub edits: Vec<String>,
+}
+
 /// The autosaved scene, if it parses and differs from `scene`: what a
 /// crashed session left unsaved.
-pub fn autosave_offer(autosaved: Option<String>, scene: &Scene) -> Option<Scene> {
+pub fn autosave_offer(autosaved: Option<String>, scene: &Scene) -> Option<AutosaveOffer> {
     let valid = crate::scene::parse_scene(&autosaved?, Path::new("autosave.ron")).ok()?;
-    Some(valid.into_scene()).filter(|s| s != scene)
+    let offered = valid.into_scene();
+    let edits = crate::scene::differences(scene, &offered, 6);
+    (!edits.is_empty()).then_some(AutosaveOffer { scene: offered, edits })
 }
 
 /// Put the layout and the autosave into `storage`.
@@ -207,40 +224,63 @@ pub fn write_state(storage: &mut dyn eframe::Storage, persisted: &Persisted, aut
     Ok(())
 }
 
-/// The state file and when it was last written: every ten seconds, and on
-/// exit; never by a `--screenshot` run, which only reads it.
+/// The state file and when it was last written: every few seconds while
+/// the studio runs (a crash loses at most that), and when it closes; never
+/// by a `--screenshot` run, which only reads it. A state that has not
+/// changed since it was last written is not written again.
 pub struct StateKeeper {
     file: Option<StateFile>,
     last_write: std::time::Instant,
+    interval: std::time::Duration,
     read_only: bool,
+    /// The text last written (or read): the file holds it already.
+    on_disk: Option<String>,
 }
 
 impl StateKeeper {
     pub fn new(read_only: bool) -> Self {
-        Self { file: None, last_write: std::time::Instant::now(), read_only }
+        Self { file: None, last_write: std::time::Instant::now(), interval: SAVE_INTERVAL, read_only, on_disk: None }
     }
 
-    pub fn keep_in(&mut self, file: StateFile) {
+    /// Keep the state in `file`, written every `interval`.
+    pub fn keep_in(&mut self, file: StateFile, interval: std::time::Duration) {
+        self.on_disk = file.text().ok();
         self.file = Some(file);
+        self.interval = interval;
     }
 
     pub fn read_only(&self) -> bool {
         self.read_only
     }
 
-    pub fn due(&self) -> bool {
-        self.last_write.elapsed() >= SAVE_INTERVAL
+    /// How long until the next write is due (None: the studio writes none).
+    pub fn due_in(&self) -> Option<std::time::Duration> {
+        let writes = self.file.is_some() && !self.read_only;
+        writes.then(|| self.interval.saturating_sub(self.last_write.elapsed()))
     }
 
-    /// Fill the file through `save` (the studio's `App::save`) and write it.
-    pub fn write(&mut self, save: impl FnOnce(&mut dyn eframe::Storage)) -> Result<(), String> {
+    /// The file to fill, if a write is due (or `now`): taken out until
+    /// `put_back`, so the studio can fill it while it holds the keeper.
+    pub fn take(&mut self, now: bool) -> Option<StateFile> {
+        if self.due_in().is_none_or(|wait| !now && !wait.is_zero()) {
+            return None;
+        }
         self.last_write = std::time::Instant::now();
-        let Some(file) = &mut self.file else { return Ok(()) };
-        save(file);
-        if self.read_only {
+        self.file.take()
+    }
+
+    /// Keep `file` again, and write it if it changed since the last write.
+    pub fn put_back(&mut self, file: StateFile) -> Result<(), String> {
+        let text = file.text();
+        self.file = Some(file);
+        let text = text.map_err(|e| format!("could not save the studio's state: {e}"))?;
+        if self.on_disk.as_ref() == Some(&text) {
             return Ok(());
         }
-        file.write().map_err(|e| format!("could not save the studio's state: {e}"))
+        let Some(file) = &self.file else { return Ok(()) };
+        file.write_text(&text).map_err(|e| format!("could not save the studio's state: {e}"))?;
+        self.on_disk = Some(text);
+        Ok(())
     }
 }
 

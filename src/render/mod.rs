@@ -18,7 +18,7 @@ pub mod settings;
 pub mod world;
 
 pub use engine::{
-    render_blocking, render_blocking_on, PassStats, RenderEvent, RenderJob, RenderSession, TileUpdate, Workers,
+    render_blocking, render_blocking_on, PassStats, RenderEvent, RenderJob, RenderSession, Switch, TileUpdate, Workers,
 };
 pub use image::LinearImage;
 pub use integrators::PhotonPassStats;

@@ -2,11 +2,13 @@
 //! objects and lights. Closed sets are enums (all variants visible here); the
 //! whole scene is `Clone + Send` so the engine renders from snapshots.
 
+mod differences;
 mod file;
 pub mod presets;
 mod valid;
 mod validate;
 
+pub use differences::{differences, shown as shown_name};
 pub use file::{load_scene, parse_scene, save_scene, to_ron, SceneFileError};
 pub use valid::ValidScene;
 pub use validate::{Invalid, Problem};

@@ -66,9 +66,10 @@ impl StudioApp {
         self.capture.exit_error()
     }
 
-    /// Keep the state in `file`: written every few seconds and on exit.
-    pub fn keep_state_in(&mut self, file: StateFile) {
-        self.state.keep_in(file);
+    /// Keep the state in `file`: written every `interval` while the studio
+    /// runs (`storage::SAVE_INTERVAL` in the window), and when it closes.
+    pub fn keep_state_in(&mut self, file: StateFile, interval: std::time::Duration) {
+        self.state.keep_in(file, interval);
     }
 
     /// Add a line to the status bar.
@@ -82,6 +83,20 @@ impl StudioApp {
         self.document.check();
         if let Some(scene) = self.document.valid().cloned() {
             self.panes.restart_all(&scene);
+        }
+        // A new document counts its revisions from 1 again
+        self.referenced_revision = 0;
+        self.follow_with_reference();
+    }
+
+    /// Let the reference follow the scene's revision, if it is new and valid.
+    pub(super) fn follow_with_reference(&mut self) {
+        let revision = self.document.revision();
+        if revision == self.referenced_revision {
+            return;
+        }
+        if let Some(scene) = self.document.valid().cloned() {
+            self.referenced_revision = revision;
             self.references.follow(&scene);
         }
     }

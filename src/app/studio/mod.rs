@@ -17,8 +17,9 @@ use super::difference::Difference;
 use super::document::Document;
 use super::files::DialogPurpose;
 use super::inspector::{inspector_ui, Selection};
-use super::keys::{input_commands, WindowState};
+use super::keys::{input_commands, Gesture, WindowState};
 use super::menu::{menu_bar_ui, MenuView};
+use super::pane::Pane;
 use super::panes::{pane_count, Panes};
 use super::plots::plots_ui;
 use super::references::References;
@@ -43,6 +44,9 @@ pub struct StudioApp {
     quit_confirmed: bool,
     state: StateKeeper,
     clock: FrameClock,
+    gesture: Gesture,
+    /// The revision the reference follows.
+    referenced_revision: u64,
     paused: bool,
     ctx: egui::Context,
 }
@@ -54,7 +58,9 @@ impl StudioApp {
         let (restored, autosaved) = read_state(storage);
         let (document, error) = Document::starting(args.scene.as_deref());
         let capture_only = args.screenshot.is_some();
-        let autosave_offer = autosave_offer(autosaved, document.scene()).filter(|_| !capture_only);
+        // A `--screenshot` run shows the offer as a start would, and leaves
+        // it unanswered: it writes nothing
+        let autosave_offer = autosave_offer(autosaved, document.scene());
         let count = pane_count(args.panes.unwrap_or(restored.panes.len().max(1)));
         // One pool of every core for all the panes, below the UI's priority
         let (workers, workers_error) = match Workers::new(0) {
@@ -70,7 +76,7 @@ impl StudioApp {
             references: References::new(ctx, restored.reference_threads, reference_cache),
             document,
             selection: Selection::Camera,
-            dialogs: Dialogs::new(autosave_offer),
+            dialogs: Dialogs::new(autosave_offer, start_folder(&restored.recent)),
             capture: args
                 .screenshot
                 .clone()
@@ -82,6 +88,8 @@ impl StudioApp {
             quit_confirmed: false,
             state: StateKeeper::new(capture_only),
             clock: FrameClock::default(),
+            gesture: Gesture::default(),
+            referenced_revision: 0,
             paused: false,
             ctx: ctx.clone(),
         };
@@ -109,7 +117,7 @@ impl StudioApp {
             Command::Undo => self.document.undo(),
             Command::Redo => self.document.redo(),
             Command::SetPanes(count) if count != self.panes.count() => {
-                self.panes.build(pane_count(count), &[], &[], &self.document.scene().settings);
+                self.panes.set_count(pane_count(count), &self.document.scene().settings);
                 self.restart_all();
             }
             Command::SetPanes(_) => {}
@@ -173,7 +181,7 @@ impl StudioApp {
         match purpose {
             DialogPurpose::OpenScene => self.apply(Command::Request(Action::Open(path))),
             DialogPurpose::SaveScene => self.save_to(&path),
-            DialogPurpose::ExportPng | DialogPurpose::ExportExr => self.export_pane(0, &path),
+            DialogPurpose::ExportImage { pane, .. } => self.export_pane(pane, &path),
             DialogPurpose::Screenshot => self.take_screenshot(path, None),
             DialogPurpose::ComparisonSheet => self.take_screenshot(path, Some(self.panes.area())),
         }
@@ -227,7 +235,7 @@ impl StudioApp {
                 can_undo: self.document.can_undo(),
                 can_redo: self.document.can_redo(),
                 recent: &self.recent,
-                panes: self.panes.count(),
+                panes: self.panes.list().iter().map(Pane::algorithm).collect(),
                 shown: self.shown,
                 file: self.document.path().map(|p| (p, self.document.is_dirty())),
             };
@@ -242,10 +250,14 @@ impl StudioApp {
             }
         });
         if self.shown.plots {
-            egui::Panel::bottom("plots")
-                .resizable(true)
-                .default_size(200.0)
-                .show(ui, |ui| plots_ui(ui, self.panes.list()));
+            egui::Panel::bottom("plots").resizable(true).default_size(200.0).show(ui, |ui| {
+                // Its size is the user's: content that grows scrolls
+                // instead of pushing the panes up as passes come in
+                let height = ui.available_height();
+                egui::ScrollArea::vertical()
+                    .auto_shrink([false, false])
+                    .show(ui, |ui| plots_ui(ui, self.panes.list(), height));
+            });
         }
         let promoted = egui::CentralPanel::default()
             .show(ui, |ui| self.panes.panes_ui(ui, &mut self.document, &mut self.selection))
@@ -261,18 +273,25 @@ impl StudioApp {
             self.promote_pane(index);
         }
 
-        self.document.commit(ctx.input(|i| i.pointer.any_down()));
+        // A drag, or wheel notches in a row, is one edit: one undo step and
+        // one reference, while the panes follow every frame of it
+        let interacting = self.gesture.interacting(&ctx);
+        self.document.commit(interacting);
         if let Some(scene) = self.document.check() {
             if !self.paused {
                 self.panes.restart_all(&scene);
-                self.references.follow(&scene);
             }
         }
+        if !interacting && !self.paused {
+            self.follow_with_reference();
+        }
         self.capture_step(&ctx);
-        if self.state.due() {
-            if let Err(e) = self.save_state() {
-                self.messages.fail(e);
-            }
+        if let Err(e) = self.save_state(false) {
+            self.messages.fail(e);
+        }
+        // An edit made just before the studio went idle is still written
+        if let Some(wait) = self.state.due_in() {
+            ctx.request_repaint_after(wait);
         }
         if self.shown.debug {
             self.clock.debug_ui(&ctx);
@@ -295,6 +314,9 @@ impl StudioApp {
                 println!("pane {}: {}", i + 1, pane.label());
             }
             println!("{}", self.references.describe());
+            if let Some(edits) = self.dialogs.offered_edits() {
+                println!("offered back: the last session's unsaved scene ({})", edits.join(", "));
+            }
             if let Some(after) = self.references.first_estimate_after() {
                 println!("reference: first own estimate {:.2} s after the scene was loaded", after.as_secs_f64());
             }
@@ -305,13 +327,20 @@ impl StudioApp {
 
     // ---- What survives a restart ---------------------------------------------
 
-    /// Write the state file (layout and autosave) if there is one.
-    fn save_state(&mut self) -> Result<(), String> {
-        let mut state = std::mem::replace(&mut self.state, StateKeeper::new(true));
-        let written = state.write(|storage| eframe::App::save(self, storage));
-        self.state = state;
-        written
+    /// Write the state file (layout and autosave), if there is one and a
+    /// write is due (or `now`).
+    fn save_state(&mut self, now: bool) -> Result<(), String> {
+        let Some(mut file) = self.state.take(now) else { return Ok(()) };
+        eframe::App::save(self, &mut file);
+        self.state.put_back(file)
     }
+}
+
+/// Where the file dialogs start: the folder of the file used last, else
+/// the folder the studio was started from.
+fn start_folder(recent: &[PathBuf]) -> PathBuf {
+    let last = recent.first().and_then(|p| p.parent()).filter(|f| !f.as_os_str().is_empty());
+    last.map(Path::to_owned).or_else(|| std::env::current_dir().ok()).unwrap_or_default()
 }
 
 impl eframe::App for StudioApp {
@@ -342,9 +371,25 @@ impl eframe::App for StudioApp {
     }
 
     fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {
+        self.save_state_at_exit();
+    }
+}
+
+impl StudioApp {
+    fn save_state_at_exit(&mut self) {
         // The window is gone: the terminal is the one place left to say it
-        if let Err(e) = self.save_state() {
+        if let Err(e) = self.save_state(true) {
             eprintln!("error: {e}");
         }
+    }
+}
+
+/// A studio dropped without `on_exit` (a panic unwinding through the window
+/// system's loop: winit's X11 code panics when the X server destroys the
+/// window under it) still writes what it keeps; after `on_exit` nothing has
+/// changed and nothing is written.
+impl Drop for StudioApp {
+    fn drop(&mut self) {
+        self.save_state_at_exit();
     }
 }

@@ -3,7 +3,7 @@
 //! and tiles sent as events. A job stops within a tile of being abandoned:
 //! every tile checks the generation it belongs to.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -40,8 +40,27 @@ pub struct RenderJob {
     /// methods only) now and then: what a viewer without a reference shows.
     pub estimate_noise: bool,
     /// Send what each strategy of a bidirectional method brings, now and
-    /// then (the studio's strategy view).
-    pub strategies: bool,
+    /// then, while this is on (the studio's strategy view, which opens and
+    /// closes while the job goes on).
+    pub strategies: Switch,
+}
+
+/// A flag the driver turns on and off while a job runs.
+#[derive(Clone, Debug, Default)]
+pub struct Switch(Arc<AtomicBool>);
+
+impl Switch {
+    pub fn new(on: bool) -> Self {
+        Self(Arc::new(AtomicBool::new(on)))
+    }
+
+    pub fn set(&self, on: bool) {
+        self.0.store(on, Ordering::Relaxed);
+    }
+
+    pub fn is_on(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
 }
 
 impl RenderJob {
@@ -53,7 +72,7 @@ impl RenderJob {
             stream_tiles: true,
             stream_variance: false,
             estimate_noise: false,
-            strategies: false,
+            strategies: Switch::default(),
         }
     }
 }
@@ -65,7 +84,7 @@ pub(super) struct JobContext<'a> {
     pub stream_tiles: bool,
     pub stream_variance: bool,
     pub estimate_noise: bool,
-    pub strategies: bool,
+    pub strategies: Switch,
     pub current: &'a AtomicU64,
     pub events: &'a Sender<RenderEvent>,
     pub notify: Option<&'a Notify>,
@@ -108,7 +127,7 @@ impl PassObserver for JobContext<'_> {
     }
 
     fn wants_strategies(&self) -> bool {
-        self.strategies
+        self.strategies.is_on()
     }
 
     fn strategies(&self, images: StrategyImages) {

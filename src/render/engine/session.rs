@@ -107,7 +107,7 @@ fn worker_loop(
             stream_tiles: job.stream_tiles,
             stream_variance: job.stream_variance,
             estimate_noise: job.estimate_noise,
-            strategies: job.strategies,
+            strategies: job.strategies.clone(),
             current: &generation,
             events: &events,
             notify: notify.as_ref(),

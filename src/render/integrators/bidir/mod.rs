@@ -182,7 +182,11 @@ impl Bidir {
     ) -> Option<PassReport> {
         let world = stage.world;
         let pixels = film.width as u64 * film.height as u64;
-        if observer.wants_strategies() && self.strategy_film.is_none() {
+        // The view opens and closes while the job goes on: counted from the
+        // pass it opened at, forgotten when it closes
+        if !observer.wants_strategies() {
+            self.strategy_film = None;
+        } else if self.strategy_film.is_none() {
             self.strategy_film = Some(StrategyFilm::new(film.width, film.height));
         }
         let mut strategy_film = self.strategy_film.take();
