@@ -278,6 +278,119 @@ fn exporting_a_pane_writes_a_png_of_the_panes_size() {
     assert!(decoded.pixels().any(|p| p.0 != [0, 0, 0]), "a rendered image, not a black one");
 }
 
+/// Type `path` into the open file dialog's path field and press its `verb`.
+fn answer_file_dialog(harness: &mut Harness<'static, StudioApp>, path: &std::path::Path, verb: &str) {
+    let field = harness.get_by_role(Role::TextInput);
+    field.focus();
+    harness.run_steps(1);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_role(Role::TextInput).type_text(&path.display().to_string());
+    harness.run_steps(1);
+    harness.get_by_label(verb).click();
+    harness.run_steps(3);
+}
+
+/// File ▸ Export image lists each pane with its algorithm; the dialog
+/// names the pane, and the file holds that pane's image.
+#[test]
+fn exporting_from_the_menu_writes_the_chosen_pane() {
+    let mut harness = studio(2);
+    // Finished: the image compared below is the one exported
+    step_until(&mut harness, |app| app.panes().list().iter().all(|p| p.state().finished));
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness.get_by_label("Export image").click();
+    harness.run_steps(2);
+    harness.get_by_label("Pane 2: Whitted ray tracing");
+    harness.get_all_by_label("PNG (display)…").nth(1).expect("pane 2's PNG").click();
+    harness.run_steps(4);
+    harness.get_by_label("Export pane 2's image (Whitted ray tracing) as PNG");
+    let path =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-ui-pane2-{}.png", std::process::id()));
+    answer_file_dialog(&mut harness, &path, "Save");
+    let decoded = image::open(&path).expect("a PNG").to_rgb8();
+    let pane = &harness.state().panes().list()[1];
+    for (png, linear) in decoded.pixels().zip(&pane.state().image.pixels) {
+        assert_eq!(png.0, gi_studio::render::image::tonemap_srgb8(*linear, pane.exposure()));
+    }
+}
+
+/// Save as… suggests the working folder (not the source tree's
+/// assets/scenes); a failed save's error goes once a save succeeds, which
+/// says "Saved".
+#[test]
+fn save_suggests_the_working_folder_and_a_good_save_clears_a_failed_ones_error() {
+    let mut harness = studio(1);
+    harness.run_steps(2);
+    let open_save_as = |harness: &mut Harness<'static, StudioApp>| {
+        harness.get_by_label("File").click();
+        harness.run_steps(2);
+        harness.get_by_label("Save as…").click();
+        // The command applies after the frame; a window's first frame sizes it
+        harness.run_steps(4);
+    };
+    open_save_as(&mut harness);
+    let suggested = harness.get_by_role(Role::TextInput).value().unwrap_or_default();
+    let here = std::env::current_dir().unwrap().join("untitled.ron");
+    assert_eq!(suggested, here.display().to_string());
+    let folder = tempfile::tempdir().unwrap();
+    answer_file_dialog(&mut harness, &folder.path().join("no such folder").join("a.ron"), "Save");
+    assert!(harness.state().messages().error.is_some(), "a save into a missing folder fails");
+    open_save_as(&mut harness);
+    let good = folder.path().join("b.ron");
+    answer_file_dialog(&mut harness, &good, "Save");
+    assert!(good.exists());
+    assert_eq!(harness.state().messages().error, None, "the failed save's error stayed");
+    assert!(harness.state().messages().status.starts_with("Saved"), "{}", harness.state().messages().status);
+}
+
+/// A sphere added from the inspector is seen: the centre of the view
+/// meets it (it was added inside the middle ball, out of sight).
+#[test]
+fn a_new_sphere_is_placed_where_the_camera_looks() {
+    use gi_studio::render::world::World;
+    let mut harness = studio(1);
+    harness.run_steps(2);
+    harness.get_all_by_label("Add").next().expect("the objects' Add").click();
+    harness.run_steps(2);
+    harness.get_by_label("Sphere").click();
+    harness.run_steps(2);
+    let scene = harness.state().scene().clone();
+    let added = scene.objects.len() - 1;
+    assert_eq!(harness.state().selection(), Selection::Object(added));
+    let valid = gi_studio::scene::ValidScene::new(scene.clone()).expect("a valid scene");
+    let world = World::new(&valid);
+    let (width, height) = (scene.settings.width, scene.settings.height);
+    let ray = CameraModel::new(&scene.camera, width, height).pixel_ray(width as f32 / 2.0, height as f32 / 2.0);
+    let seen = world.intersect(&ray, f32::INFINITY).map(|hit| hit.object as usize);
+    assert_eq!(seen, Some(added), "the new sphere is not where the camera looks");
+}
+
+/// A drag of 80 points turns the Cornell box's camera by a few degrees
+/// (the field of view per image height), not out through its walls.
+#[test]
+fn an_orbit_drag_turns_with_the_view() {
+    let mut harness = studio(1);
+    harness.run_steps(2);
+    let rect = harness.state().panes().rects()[0];
+    let start = rect.center();
+    harness.hover_at(start);
+    harness.run_steps(1);
+    harness.drag_at(start);
+    harness.run_steps(1);
+    for step in 1..=8 {
+        harness.hover_at(start + egui::vec2(10.0 * step as f32, 0.0));
+        harness.run_steps(1);
+    }
+    harness.drop_at(start + egui::vec2(80.0, 0.0));
+    harness.run_steps(2);
+    let camera = &harness.state().scene().camera;
+    let turned = (camera.position - camera.look_at).angle_between(glam::Vec3::new(0.0, 0.0, 3.4)).to_degrees();
+    let expected = 40.0 * 80.0 / rect.height();
+    assert!((turned - expected).abs() < 0.5, "turned {turned}° for an 80-point drag, not {expected}°");
+    assert!(camera.position.x.abs() < 1.0, "the camera left the box: {}", camera.position);
+}
+
 #[test]
 fn clicking_a_sphere_in_the_viewport_selects_it() {
     let mut harness = studio(1);

@@ -13,6 +13,16 @@ use crate::render::world::World;
 use crate::scene::presets::default_scene;
 use crate::scene::{load_scene, save_scene, to_ron, Invalid, Scene, SceneFileError, ValidScene};
 
+/// A place in view to put a new object.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spot {
+    pub point: glam::Vec3,
+    /// The surface's normal there, toward the camera.
+    pub normal: glam::Vec3,
+    /// How far it is from the camera.
+    pub distance: f32,
+}
+
 pub struct Document {
     scene: Scene,
     path: Option<PathBuf>,
@@ -146,6 +156,28 @@ impl Document {
         let (scene, world) = self.valid.as_ref().filter(|_| self.problems.is_empty())?;
         let ray = CameraModel::new(&scene.camera, width, height).pixel_ray(x, y);
         world.intersect(&ray, f32::INFINITY).map(|hit| hit.object as usize)
+    }
+
+    /// Where the centre of the view meets the scene (its last valid
+    /// revision): the point, the surface's normal turned toward the camera,
+    /// and the distance from the camera. Where nothing is met, the look-at
+    /// point, facing the camera.
+    pub fn spot_in_view(&self) -> Spot {
+        let camera = &self.scene.camera;
+        let to_look_at = camera.look_at - camera.position;
+        let facing = -to_look_at.normalize_or(glam::Vec3::Z);
+        let at_look_at = Spot { point: camera.look_at, normal: facing, distance: to_look_at.length().max(1e-3) };
+        let Some((scene, world)) = self.valid.as_ref().filter(|_| self.problems.is_empty()) else { return at_look_at };
+        let (width, height) = (scene.settings.width, scene.settings.height);
+        let ray = CameraModel::new(&scene.camera, width, height).pixel_ray(width as f32 / 2.0, height as f32 / 2.0);
+        match world.intersect(&ray, f32::INFINITY) {
+            Some(hit) => {
+                let normal = hit.surface.normal;
+                let normal = if normal.dot(ray.direction) > 0.0 { -normal } else { normal };
+                Spot { point: hit.surface.point, normal, distance: (hit.surface.point - ray.origin).length() }
+            }
+            None => at_look_at,
+        }
     }
 
     /// Write the scene to `path`; it is the document's file from then on.

@@ -6,6 +6,7 @@
 use eframe::egui;
 use glam::Vec3;
 
+use super::document::Spot;
 use super::widgets::{committed_text_ui, number, slider};
 
 use crate::scene::{Attenuation, ClipAlong, Invalid, Light, LightKind, Material, MaterialModel, Object, Scene, Shape};
@@ -20,7 +21,15 @@ pub enum Selection {
 }
 
 /// Draw the inspector; returns whether the scene changed.
-pub fn inspector_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection, problems: &[Invalid]) -> bool {
+/// Draw the inspector; returns whether the scene changed. New objects go
+/// to `spot`, where the centre of the view meets the scene.
+pub fn inspector_ui(
+    ui: &mut egui::Ui,
+    scene: &mut Scene,
+    selection: &mut Selection,
+    problems: &[Invalid],
+    spot: Spot,
+) -> bool {
     if !problems.is_empty() {
         egui::Frame::new().fill(ui.visuals().extreme_bg_color).inner_margin(6.0).show(ui, |ui| {
             ui.colored_label(ui.visuals().error_fg_color, "Not rendered until fixed:");
@@ -33,7 +42,7 @@ pub fn inspector_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Select
         .auto_shrink([false, false])
         .show(ui, |ui| {
             ui.selectable_value(selection, Selection::Camera, "Camera");
-            let listed = list_ui(ui, scene, selection);
+            let listed = list_ui(ui, scene, selection, spot);
             ui.separator();
             ui.heading(selected_title(scene, *selection));
             listed | properties_ui(ui, scene, selection)
@@ -55,7 +64,7 @@ fn unique_name(base: &str, taken: impl Fn(&str) -> bool) -> String {
 }
 
 /// The lists with their add, duplicate and delete buttons.
-fn list_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection) -> bool {
+fn list_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection, spot: Spot) -> bool {
     let before = (scene.objects.len(), scene.materials.len(), scene.lights.len());
     let mut toggled = false;
     egui::CollapsingHeader::new("Objects").default_open(true).show(ui, |ui| {
@@ -70,9 +79,9 @@ fn list_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection) -> b
             ui.menu_button("Add", |ui| {
                 let material = scene.materials.first().map(|m| m.name.clone()).unwrap_or_default();
                 let shapes = [
-                    ("Sphere", Shape::Sphere { center: Vec3::new(0.0, 0.5, 0.0), radius: 0.5 }),
+                    ("Sphere", sphere_at(spot)),
                     ("Plane", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }),
-                    ("Triangle", Shape::Triangle { a: Vec3::ZERO, b: Vec3::X, c: Vec3::Y }),
+                    ("Triangle", triangle_at(spot)),
                 ];
                 for (label, shape) in shapes {
                     if ui.button(label).clicked() {
@@ -182,6 +191,27 @@ fn list_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection) -> b
     });
     // One click a frame: an add, a duplicate or a delete changes a count
     toggled || (scene.objects.len(), scene.materials.len(), scene.lights.len()) != (before.0, before.1, before.2)
+}
+
+/// A sphere resting on the surface at `spot`, a twelfth of its distance
+/// across: seen where the view's centre is, whatever the scene's scale.
+pub fn sphere_at(spot: Spot) -> Shape {
+    let radius = (spot.distance / 12.0).max(1e-3);
+    Shape::Sphere { center: spot.point + spot.normal * radius, radius }
+}
+
+/// A triangle facing the camera just in front of the surface at `spot`.
+pub fn triangle_at(spot: Spot) -> Shape {
+    let size = (spot.distance / 8.0).max(1e-3);
+    let centre = spot.point + spot.normal * (size * 0.5);
+    // u × v = normal: the winding (b − a) × (c − a) faces the camera
+    let u = spot.normal.any_orthonormal_vector();
+    let v = spot.normal.cross(u);
+    Shape::Triangle {
+        a: centre - u * size - v * (0.6 * size),
+        b: centre + u * size - v * (0.6 * size),
+        c: centre + v * size,
+    }
 }
 
 fn shape_name(shape: &Shape) -> &'static str {

@@ -26,6 +26,15 @@ pub fn orbit(camera: &mut Camera, yaw: f32, pitch: f32) {
     }
 }
 
+/// The turn of a drag by `delta` points over an image `height` points
+/// high: a drag the image's height turns by the field of view, so the
+/// scene under the cursor moves with it, at any scale of scene or lens (a
+/// fixed angle a point took an 80-point drag out of the Cornell box).
+pub fn orbit_angles(camera: &Camera, delta: egui::Vec2, height: f32) -> (f32, f32) {
+    let per_point = camera.fov_y_degrees.to_radians() / height.max(1.0);
+    (-delta.x * per_point, -delta.y * per_point)
+}
+
 /// Move position and look-at together across the view.
 pub fn pan(camera: &mut Camera, dx: f32, dy: f32) {
     let forward = (camera.look_at - camera.position).normalize_or(Vec3::NEG_Z);
@@ -101,7 +110,8 @@ pub fn viewport_ui(
         if ui.input(|i| i.modifiers.shift) {
             pan(camera, delta.x / rect.height(), delta.y / rect.height());
         } else {
-            orbit(camera, -delta.x * 0.01, -delta.y * 0.01);
+            let (yaw, pitch) = orbit_angles(camera, delta, rect.height());
+            orbit(camera, yaw, pitch);
         }
         document.changed();
     }

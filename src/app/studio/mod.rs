@@ -245,7 +245,8 @@ impl StudioApp {
         egui::Panel::bottom("reference").show(ui, |ui| self.references.reference_ui(ui));
         egui::Panel::left("inspector").resizable(true).default_size(330.0).show(ui, |ui| {
             let problems = self.document.problems().to_vec();
-            if inspector_ui(ui, self.document.scene_mut(), &mut self.selection, &problems) {
+            let spot = self.document.spot_in_view();
+            if inspector_ui(ui, self.document.scene_mut(), &mut self.selection, &problems, spot) {
                 self.document.changed();
             }
         });
