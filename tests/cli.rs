@@ -548,3 +548,37 @@ fn help_names_every_algorithm() {
         assert!(help.contains(&algorithm.label().to_lowercase()), "--help does not name {}", algorithm.label());
     }
 }
+
+/// A point light inside the glass ball: path tracing and Whitted say, in
+/// one line, that they cannot see it and which algorithms can; VCM renders
+/// it without a word.
+#[test]
+fn a_light_inside_glass_is_named_by_the_algorithms_that_cannot_see_it() {
+    let dir = temp_dir("bulb");
+    let scene = dir.join("bulb.ron");
+    let bulb =
+        "lights: [(name: \"bulb\", kind: Point(position: (0.45, 0.35, 0.2)), color: (1.0, 1.0, 1.0), intensity: 5.0)],";
+    let text = std::fs::read_to_string("assets/scenes/cornell.ron").unwrap().replace("lights: [],", bulb);
+    std::fs::write(&scene, text).unwrap();
+    for (algo, warned) in [("path", true), ("whitted", true), ("vcm", false)] {
+        let output = gi_studio()
+            .arg("render")
+            .arg(&scene)
+            .args(["--algo", algo])
+            .args(SMALL)
+            .arg("-o")
+            .arg(dir.join(format!("{algo}.png")))
+            .output()
+            .unwrap();
+        assert_exit(&output, 0);
+        let warnings: Vec<String> =
+            stderr(&output).lines().filter(|l| l.starts_with("warning:")).map(str::to_owned).collect();
+        if warned {
+            assert_eq!(warnings.len(), 1, "{warnings:?}");
+            assert!(warnings[0].contains("light “bulb” is inside the glass of “glass ball”"), "{}", warnings[0]);
+            assert!(warnings[0].contains("Vertex connection and merging"), "{}", warnings[0]);
+        } else {
+            assert!(warnings.is_empty(), "{algo}: {warnings:?}");
+        }
+    }
+}

@@ -100,8 +100,12 @@ fn merging_refuses_foreign_missing_and_duplicate_parts() {
     let mut reseeded = parts.clone();
     reseeded[1].1.manifest.seed += 1;
     assert!(message(&reseeded).contains("(its seed differs)"));
+    let mut retuned = parts.clone();
+    retuned[3].1.manifest.settings_key = "fedcba9876543210".into();
+    assert!(message(&retuned).contains("(its settings differ)"), "{}", message(&retuned));
     let missing = [parts[0].clone(), parts[1].clone(), parts[3].clone()];
-    assert!(message(&missing).contains("shards 2 of 4 are missing"), "{}", message(&missing));
+    assert!(message(&missing).contains("shard 2 of 4 is missing"), "{}", message(&missing));
+    assert!(message(&[parts[0].clone(), parts[3].clone()]).contains("shards 1, 2 of 4 are missing"));
     assert!(merge(&missing, false).is_ok(), "--partial merges what there is");
     let twice = [parts[0].clone(), parts[1].clone(), parts[1].clone(), parts[3].clone()];
     assert!(message(&twice).contains("part-1.exr and part-1.exr are both shard 1/4"));

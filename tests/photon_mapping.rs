@@ -200,8 +200,8 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
     let mut s = settings(Algorithm::Photon, 32, 24, 2);
     s.set_photons(20_000);
     let camera = CameraModel::new(&scene.camera, s.width, s.height);
-    let (world, visible) = World::for_view(&valid(scene.clone()), &camera, s.width, s.height);
-    let maps = PhotonMaps::build(&world, s.photon().unwrap(), s.seed, s.max_depth, visible);
+    let (world, _) = World::for_view(&valid(scene.clone()), &camera, s.width, s.height);
+    let maps = PhotonMaps::build(&world, s.photon().unwrap(), s.seed, s.max_depth);
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-pmap-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("caustics.pmap");
@@ -241,15 +241,15 @@ fn saved_maps_give_a_bit_identical_image_and_mismatches_are_refused() {
 /// damage with its own message: a flipped bit anywhere (the checksum), and,
 /// in a file whose checksum was made to match, a photon count larger than
 /// the file (refused before allocating for it), a photon that is not
-/// finite, a tree out of order and a gather radius that is not a radius.
+/// finite, a tree out of order and photons all moved to one point.
 #[test]
 fn damaged_photon_maps_are_refused_each_with_its_own_message() {
     let scene = presets::preset("caustics").unwrap().unwrap();
     let mut s = settings(Algorithm::Photon, 32, 24, 1);
     s.set_photons(2_000);
     let camera = CameraModel::new(&scene.camera, s.width, s.height);
-    let (world, visible) = World::for_view(&valid(scene.clone()), &camera, s.width, s.height);
-    let maps = PhotonMaps::build(&world, s.photon().unwrap(), s.seed, s.max_depth, visible);
+    let (world, _) = World::for_view(&valid(scene.clone()), &camera, s.width, s.height);
+    let maps = PhotonMaps::build(&world, s.photon().unwrap(), s.seed, s.max_depth);
     assert!(maps.global.len() > 100);
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-pmap-damage-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -266,9 +266,9 @@ fn damaged_photon_maps_are_refused_each_with_its_own_message() {
             Ok(_) => panic!("{name}: a damaged map was accepted"),
         }
     };
-    // The body starts after the 32-byte header and the global map's 16-byte counts
-    let (header, body) = (32, 48);
-    for at in [header - 4, body, body + 13, bytes.len() / 2, bytes.len() - 9] {
+    // The body starts after the 28-byte header and the global map's 16-byte counts
+    let (header, body) = (28, 44);
+    for at in [header + 4, body, body + 13, bytes.len() / 2, bytes.len() - 9] {
         let mut flipped = bytes.clone();
         flipped[at] ^= 0x10;
         assert!(load(&format!("flip{at}.pmap"), &flipped).contains("checksum"), "byte {at}");
@@ -295,9 +295,14 @@ fn damaged_photon_maps_are_refused_each_with_its_own_message() {
     swapped.copy_within(b..b + 28, a);
     swapped[b..b + 28].copy_from_slice(&first);
     assert!(load("order.pmap", &resealed(swapped)).contains("out of the tree's order"));
-    let mut radius = bytes.clone();
-    radius[header - 4..header].copy_from_slice(&f32::INFINITY.to_le_bytes());
-    assert!(load("radius.pmap", &resealed(radius)).contains("gather radius is inf"));
+    // Every photon moved to the first one's place
+    let mut one_point = bytes.clone();
+    let count = u64::from_le_bytes(bytes[header + 8..header + 16].try_into().unwrap()) as usize;
+    for i in 1..count {
+        one_point.copy_within(body..body + 12, body + 28 * i);
+    }
+    let reason = load("one-point.pmap", &resealed(one_point));
+    assert!(reason.contains(&format!("all {count} photons of the global map lie at one point")), "{reason}");
     assert!(load("extra.pmap", &[bytes.as_slice(), &[0]].concat()).contains("checksum belong"));
     load_photon_maps(&good, scene_key, key).expect("the untouched file still loads");
 }

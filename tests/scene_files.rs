@@ -189,3 +189,63 @@ fn exposure_and_size_beyond_their_limits_are_refused() {
         matches!(p, Problem::TooManyPixels { width: 16384, height: 16384 })
     });
 }
+
+/// The saved (pretty, one field a line) form of a scene: a duplicate name
+/// is reported on the second name's line, a missing material on the
+/// `material:` line of its object, whichever order the object's fields
+/// are written in.
+#[test]
+fn problems_in_the_saved_form_are_on_their_own_lines() {
+    let scene = presets::preset("cornell").unwrap().unwrap();
+    let saved = to_ron(&scene).unwrap();
+    let at = |text: &str, line: usize| text.lines().nth(line - 1).unwrap_or_default().to_owned();
+    let line_of_error = |text: &str| match parse_scene(text, Path::new("broken.ron")) {
+        Err(SceneFileError::Invalid { line, .. }) => line,
+        other => panic!("expected a validation error, got {other:?}"),
+    };
+
+    // The second of two objects named "floor"
+    let twice = saved.replacen("name: \"ceiling\"", "name: \"floor\"", 1);
+    let line = line_of_error(&twice);
+    assert_eq!(line, line_of(&saved, "name: \"ceiling\""), "line {line}: {}", at(&twice, line));
+
+    // A missing material, and the same with `material:` before `name:`
+    let missing = saved.replacen("material: \"red\"", "material: \"nowhere\"", 1);
+    let line = line_of_error(&missing);
+    assert!(at(&missing, line).contains("\"nowhere\""), "line {line}: {}", at(&missing, line));
+    let reordered = CORNELL.replacen(
+        "(name: \"left wall\", shape: Plane(point: (-1.0, 0.0, 0.0), normal: (1.0, 0.0, 0.0)), material: \"red\")",
+        "(material: \"nowhere\",\n         name: \"left wall\", shape: Plane(point: (-1.0, 0.0, 0.0), normal: (1.0, 0.0, 0.0)))",
+        1,
+    );
+    let line = line_of_error(&reordered);
+    assert!(at(&reordered, line).contains("\"nowhere\""), "line {line}: {}", at(&reordered, line));
+
+    // An object named as a material, whose name the objects' section first
+    // shows as an earlier object's material
+    let named_white = CORNELL.replacen("(name: \"ceiling\"", "(name: \"white\"", 1).replacen(
+        "material: \"glass\")",
+        "material: \"nowhere\")",
+        1,
+    );
+    let line = line_of_error(&named_white);
+    assert!(at(&named_white, line).contains("\"nowhere\""), "line {line}: {}", at(&named_white, line));
+}
+
+/// A name of 10,000 characters is not echoed in full: the message names
+/// it by its first 40.
+#[test]
+fn a_huge_name_is_cut_in_the_message() {
+    let long = "x".repeat(10_000);
+    let twice = CORNELL.replacen("name: \"floor\"", &format!("name: \"{long}\""), 1).replacen(
+        "name: \"ceiling\"",
+        &format!("name: \"{long}\""),
+        1,
+    );
+    let missing = CORNELL.replacen("material: \"red\")", &format!("material: \"{long}\")"), 1);
+    for text in [twice, missing] {
+        let message = parse_scene(&text, Path::new("broken.ron")).unwrap_err().to_string();
+        assert!(message.len() < 300, "{} characters: {}…", message.len(), &message[..200]);
+        assert!(message.contains(&format!("{}…", "x".repeat(40))), "{message}");
+    }
+}

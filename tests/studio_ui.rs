@@ -144,6 +144,28 @@ fn a_dolly_gesture_is_one_undo_step() {
     assert_eq!(*harness.state().scene(), original, "one undo takes back the whole gesture");
 }
 
+/// A point light inside the glass ball: each pane whose algorithm cannot
+/// see it says so on its image.
+#[test]
+fn panes_say_when_their_algorithm_cannot_see_a_light() {
+    let mut harness = studio(2);
+    harness.run_steps(2);
+    assert!(harness.query_by_label_contains("cannot see its light").is_none());
+    harness.state_mut().edit_scene(|scene| {
+        scene.lights.push(gi_studio::scene::Light {
+            name: "bulb".into(),
+            kind: gi_studio::scene::LightKind::Point { position: glam::Vec3::new(0.45, 0.35, 0.2) },
+            color: glam::Vec3::ONE,
+            intensity: 5.0,
+            attenuation: gi_studio::scene::Attenuation::default(),
+            enabled: true,
+        })
+    });
+    harness.run_steps(3);
+    harness.get_by_label_contains("Path tracing cannot see its light");
+    harness.get_by_label_contains("Whitted ray tracing cannot see its light");
+}
+
 #[test]
 fn toggling_a_light_changes_the_scene_and_restarts() {
     let mut harness = studio(1);

@@ -17,6 +17,7 @@ use crate::render::film::NoiseEstimate;
 use crate::render::image::Tonemap;
 use crate::render::integrators::bidir::strategies::StrategyImages;
 use crate::render::integrators::photon_map::PhotonMapStats;
+use crate::render::unseen::unseen_lights;
 use crate::render::world::camera::TileRect;
 use crate::render::{
     Algorithm, LinearImage, Method, MisHeuristic, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings,
@@ -209,6 +210,8 @@ pub struct Pane {
     strategy_view: StrategyView,
     /// On while the strategy view is open; every job of the pane reads it.
     strategies: Switch,
+    /// What the pane's algorithm cannot show of the scene (`unseen`).
+    warning: Option<String>,
 }
 
 impl Pane {
@@ -230,7 +233,7 @@ impl Pane {
             }
         };
         let (strategy_view, strategies) = (StrategyView::default(), Switch::default());
-        Self { state, settings, exposure, session, texture: None, strategy_view, strategies }
+        Self { state, settings, exposure, session, texture: None, strategy_view, strategies, warning: None }
     }
 
     pub fn settings(&self) -> &RenderSettings {
@@ -282,11 +285,18 @@ impl Pane {
 
     /// Abandon the current job and render `scene` afresh (never waits).
     pub fn restart(&mut self, scene: Arc<ValidScene>) {
+        let unseen = unseen_lights(&scene, self.algorithm());
+        self.warning = (!unseen.is_empty()).then(|| unseen.join("; "));
         let Some(session) = &self.session else { return };
         let strategies = self.strategies.clone();
         let job = RenderJob { estimate_noise: true, strategies, ..RenderJob::new(scene, self.settings.clone()) };
         let generation = session.start(job);
         self.state = PaneState::new(generation, self.settings.width, self.settings.height);
+    }
+
+    /// What the pane's algorithm cannot show of its scene, if anything.
+    pub fn warning(&self) -> Option<&str> {
+        self.warning.as_deref()
     }
 
     pub fn pause(&mut self) {

@@ -84,6 +84,16 @@ pub fn viewport_ui(
          Panes take turns on the threads, fairly by time, so a pane's clock, samples per second \
          and error curve do not depend on how many panes render beside it.",
     );
+    if let Some(warning) = pane.warning() {
+        // Along the image's foot, wrapped to its width, and told to tests
+        let text = egui::RichText::new(format!("Note: {warning}")).color(ui.visuals().warn_fg_color);
+        let below = egui::Rect::from_min_max(egui::pos2(rect.min.x, rect.max.y - 60.0), rect.max).shrink(6.0);
+        let mut child =
+            ui.new_child(egui::UiBuilder::new().max_rect(below).layout(egui::Layout::bottom_up(egui::Align::Min)));
+        egui::Frame::new().fill(egui::Color32::from_black_alpha(180)).inner_margin(4.0).show(&mut child, |ui| {
+            ui.label(text);
+        });
+    }
     if let Some(message) = &pane.state().failed {
         ui.painter().text(
             rect.center(),

@@ -23,6 +23,7 @@ use crate::analysis::reference::{
 };
 use crate::fileio::{self, SIGNATURE};
 use crate::limits;
+use crate::render::unseen::unseen_lights;
 use crate::render::{
     Algorithm, LinearImage, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers,
 };
@@ -254,6 +255,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             };
             if let (Method::Vcm(m), Some(merges)) = (&mut settings.method, args.merges) {
                 merges.apply(m);
+            }
+            for line in unseen_lights(&subject.scene, algorithm) {
+                eprintln!("warning: {name}: {line}");
             }
             let bar = ProgressBar::new((args.budget * 10.0).ceil() as u64).with_message(format!("{name} {algorithm}"));
             bar.set_style(

@@ -41,9 +41,8 @@ pub fn run(args: &PhotonsArgs) -> Result<()> {
     let bar = ProgressBar::new_spinner().with_message("tracing photons");
     bar.enable_steady_tick(Duration::from_millis(120));
     let camera = CameraModel::new(&scene.camera, settings.width, settings.height);
-    let (world, visible_radius) = World::for_view(&scene, &camera, settings.width, settings.height);
-    let maps = (args.flags.workers()?)
-        .run(|| PhotonMaps::build(&world, photon, settings.seed, settings.max_depth, visible_radius));
+    let (world, _) = World::for_view(&scene, &camera, settings.width, settings.height);
+    let maps = (args.flags.workers()?).run(|| PhotonMaps::build(&world, photon, settings.seed, settings.max_depth));
     bar.finish_and_clear();
     let key = settings_key(photon, settings.seed, settings.max_depth);
     save_photon_maps(&maps, scene.content_key(), key, &args.output)?;

@@ -16,6 +16,7 @@ use crate::render::image::ImageFormat;
 use crate::render::integrators::photon_map::file::{load_photon_maps, settings_key};
 use crate::render::integrators::photon_map::maps::MapStats;
 use crate::render::integrators::photon_map::PhotonMapStats;
+use crate::render::unseen::unseen_lights;
 use crate::render::{
     Algorithm, LinearImage, Method, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings, Workers,
 };
@@ -103,6 +104,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     outputs.claim(&args.output, &[SIGNATURE.as_bytes()])?;
     let settings = args.flags.settings(&scene)?;
     let exposure = args.flags.exposure.unwrap_or(scene.settings.exposure);
+    for line in unseen_lights(&scene, settings.algorithm()) {
+        eprintln!("warning: {line}");
+    }
     let mut job = RenderJob::new(Arc::new(scene), settings.clone());
     if let Some(path) = &args.photon_map {
         let Method::Photon(photon) = &settings.method else {

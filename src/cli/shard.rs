@@ -207,18 +207,18 @@ pub fn merge(parts: &[(PathBuf, Partial)], complete: bool) -> Result<Merged> {
     for (path, part) in parts {
         let m = &part.manifest;
         let differs = [
-            (m.scene_key != m0.scene_key, "scene"),
-            (m.algorithm != m0.algorithm, "algorithm"),
-            (m.settings_key != m0.settings_key, "settings"),
-            (m.seed != m0.seed, "seed"),
-            ((m.width, m.height) != (m0.width, m0.height), "size"),
-            (m.shards != m0.shards || m.samples_per_pixel != m0.samples_per_pixel, "split"),
+            (m.scene_key != m0.scene_key, "its scene differs"),
+            (m.algorithm != m0.algorithm, "its algorithm differs"),
+            (m.settings_key != m0.settings_key, "its settings differ"),
+            (m.seed != m0.seed, "its seed differs"),
+            ((m.width, m.height) != (m0.width, m0.height), "its size differs"),
+            (m.shards != m0.shards || m.samples_per_pixel != m0.samples_per_pixel, "it is split otherwise"),
         ]
         .into_iter()
         .find_map(|(differs, what)| differs.then_some(what));
         if let Some(what) = differs {
             bail!(
-                "{}: from another render than {} (its {what} differs): shards merge only with their own",
+                "{}: from another render than {} ({what}): shards merge only with their own",
                 path.display(),
                 first_path.display()
             );
@@ -234,7 +234,8 @@ pub fn merge(parts: &[(PathBuf, Partial)], complete: bool) -> Result<Merged> {
     let missing: Vec<String> =
         seen.iter().enumerate().filter(|(_, p)| p.is_none()).map(|(i, _)| i.to_string()).collect();
     if complete && !missing.is_empty() {
-        bail!("shards {} of {} are missing (merge what there is with --partial)", missing.join(", "), m0.shards);
+        let (shards, are) = if missing.len() == 1 { ("shard", "is") } else { ("shards", "are") };
+        bail!("{shards} {} of {} {are} missing (merge what there is with --partial)", missing.join(", "), m0.shards);
     }
     let passes: u64 = parts.iter().map(|(_, p)| p.manifest.passes as u64).sum();
     let (width, height) = (m0.width, m0.height);

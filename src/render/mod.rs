@@ -15,6 +15,7 @@ pub mod image;
 pub mod integrators;
 pub mod layers;
 pub mod settings;
+pub mod unseen;
 pub mod world;
 
 pub use engine::{

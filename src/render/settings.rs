@@ -45,6 +45,12 @@ impl Algorithm {
         }
     }
 
+    /// Whether it traces paths from the lights too: only such a method
+    /// sees a point light through glass (`unseen`).
+    pub fn traces_from_lights(self) -> bool {
+        !matches!(self, Algorithm::Whitted | Algorithm::Path)
+    }
+
     pub fn label(self) -> &'static str {
         match self {
             Algorithm::Whitted => "Whitted ray tracing",

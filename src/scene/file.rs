@@ -65,29 +65,61 @@ pub fn save_scene(scene: &Scene, path: &Path) -> Result<(), SceneFileError> {
     Ok(fileio::write_bytes(path, text.as_bytes())?)
 }
 
-/// Where an invalid value sits in the text: the section, then the item's
-/// quoted name (the duplicate's second occurrence), then `key:`. RON gives no
-/// spans after deserialising, and names are unique, so this finds the field.
+/// Where an invalid value sits in the text: the section, then its list's
+/// item by place (RON gives no spans after deserialising; names can repeat
+/// and be written in any field order), then `key:` within that item.
 fn locate(text: &str, invalid: &Invalid) -> (usize, usize) {
     let section = if invalid.section == "scene" { Some(0) } else { find_key(text, 0, invalid.section) };
     let mut at = section.unwrap_or(0);
-    if let Some(item) = &invalid.item {
-        let quoted = format!("\"{item}\"");
-        if let Some(found) = text[at..].find(&quoted) {
-            at += found;
-            if matches!(invalid.problem, super::Problem::DuplicateName(_)) {
-                if let Some(again) = text[at + quoted.len()..].find(&quoted) {
-                    at += quoted.len() + again;
-                }
-            }
+    let mut end = text.len();
+    if let (Some(section), Some(index)) = (section, invalid.index) {
+        if let Some(item) = list_item(text, section, index) {
+            (at, end) = (item.start, item.end);
         }
     }
-    if !matches!(invalid.problem, super::Problem::DuplicateName(_)) {
-        if let Some(found) = find_key(text, at, invalid.key) {
-            at = found;
-        }
+    if let Some(found) = find_key(&text[..end], at, invalid.key) {
+        at = found;
     }
     line_column(text, at)
+}
+
+/// The `index`th item of the first list after `from`: what lies between
+/// its commas at the list's own depth, strings and comments skipped.
+fn list_item(text: &str, from: usize, index: usize) -> Option<std::ops::Range<usize>> {
+    let bytes = text.as_bytes();
+    let open = from + text[from..].find('[')?;
+    let (mut depth, mut item, mut start) = (0usize, 0usize, open + 1);
+    let mut i = open;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'"' => {
+                // To the closing quote, over escapes
+                i += 1;
+                while i < bytes.len() && bytes[i] != b'"' {
+                    i += if bytes[i] == b'\\' { 2 } else { 1 };
+                }
+            }
+            b'/' if bytes.get(i + 1) == Some(&b'/') => i = text[i..].find('\n').map_or(bytes.len(), |n| i + n),
+            b'/' if bytes.get(i + 1) == Some(&b'*') => i = text[i + 2..].find("*/").map_or(bytes.len(), |n| i + n + 3),
+            b'(' | b'[' | b'{' => depth += 1,
+            b')' | b']' | b'}' => {
+                depth = depth.saturating_sub(1);
+                if depth == 0 {
+                    return (item == index).then_some(start..i);
+                }
+            }
+            b',' if depth == 1 => {
+                if item == index {
+                    return Some(start..i);
+                }
+                item += 1;
+                start = i + 1;
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    None
 }
 
 /// Byte offset of `key` followed by optional spaces and `:` at or after `from`.

@@ -5,6 +5,7 @@ use std::collections::HashSet;
 
 use glam::Vec3;
 
+use super::differences::shown as shown_name;
 use super::{LightKind, MaterialModel, Scene, Shape};
 use crate::limits;
 
@@ -17,6 +18,8 @@ pub struct Invalid {
     pub field: String,
     /// Top-level section: `camera`, `settings`, `materials`, `objects`, `lights`.
     pub section: &'static str,
+    /// The place of the list item in its section, when the value belongs to one.
+    pub index: Option<usize>,
     /// The name of the list item, when the value belongs to one.
     pub item: Option<String>,
     /// The last field name on the path (`radius`).
@@ -55,6 +58,7 @@ pub enum Problem {
 struct Checker<'a> {
     found: Vec<Invalid>,
     section: &'static str,
+    index: Option<usize>,
     item: Option<&'a str>,
     prefix: String,
 }
@@ -62,9 +66,10 @@ struct Checker<'a> {
 impl<'a> Checker<'a> {
     fn at(&mut self, section: &'static str, index: Option<usize>, item: Option<&'a str>, middle: &str) {
         self.section = section;
+        self.index = index;
         self.item = item;
         self.prefix = match (index, item) {
-            (Some(i), Some(name)) => format!("{section}[{i}] \"{name}\"{middle}"),
+            (Some(i), Some(name)) => format!("{section}[{i}] \"{}\"{middle}", shown_name(name)),
             (Some(i), None) => format!("{section}[{i}]{middle}"),
             _ => format!("{section}{middle}"),
         };
@@ -74,6 +79,7 @@ impl<'a> Checker<'a> {
         self.found.push(Invalid {
             field: format!("{}.{key}", self.prefix),
             section: self.section,
+            index: self.index,
             item: self.item.map(str::to_owned),
             key,
             problem,
@@ -130,13 +136,13 @@ impl<'a> Checker<'a> {
         if name.trim().is_empty() {
             self.report("name", Problem::EmptyName);
         } else if !seen.insert(name) {
-            self.report("name", Problem::DuplicateName(name.to_owned()));
+            self.report("name", Problem::DuplicateName(shown_name(name)));
         }
     }
 }
 
 pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
-    let mut check = Checker { found: Vec::new(), section: "camera", item: None, prefix: String::new() };
+    let mut check = Checker { found: Vec::new(), section: "camera", index: None, item: None, prefix: String::new() };
 
     let camera = &scene.camera;
     check.at("camera", None, None, "");
@@ -209,7 +215,7 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
         check.at("objects", Some(i), Some(&object.name), "");
         check.name(&mut names, &object.name);
         if scene.material_index(&object.material).is_none() {
-            check.report("material", Problem::UnknownMaterial(object.material.clone()));
+            check.report("material", Problem::UnknownMaterial(shown_name(&object.material)));
         }
         check.at("objects", Some(i), Some(&object.name), ".shape");
         match &object.shape {

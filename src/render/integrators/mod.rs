@@ -28,6 +28,7 @@ use crate::render::world::camera::{CameraModel, CameraTile, TileRect};
 use crate::render::world::rng::PassStreams;
 use crate::render::world::World;
 use crate::scene::Rgb;
+use photon_map::maps::resolve_max_radius;
 use photon_map::{PhotonMapStats, PhotonMaps, QueryStats};
 
 /// Work counted per tile and summed per pass.
@@ -197,11 +198,17 @@ impl Integrator {
                         photon,
                         settings.seed,
                         settings.max_depth,
-                        visible_radius,
                         &|| observer.is_current(),
                     )?),
                 };
-                Integrator::Photon(photon::PhotonMapping::new(stage.world, maps, photon, settings.max_depth))
+                let max_radius = resolve_max_radius(visible_radius, photon);
+                Integrator::Photon(photon::PhotonMapping::new(
+                    stage.world,
+                    maps,
+                    photon,
+                    settings.max_depth,
+                    max_radius,
+                ))
             }
             Method::Sppm(sppm) => Integrator::Sppm(sppm::Sppm::new(stage.world, film, sppm, settings, visible_radius)),
             Method::LightTracing | Method::Bdpt(_) | Method::Bpm(_) | Method::Vcm(_) => {

@@ -41,6 +41,8 @@ impl PhotonScratch {
 /// Photon mapping with the maps of one job.
 pub struct PhotonMapping {
     pub maps: Arc<PhotonMaps>,
+    /// The largest gather radius (`maps::resolve_max_radius`).
+    max_radius: f32,
     settings: PhotonSettings,
     max_depth: u32,
     /// The world for eight rays at a time, where it can be compiled: the
@@ -49,8 +51,15 @@ pub struct PhotonMapping {
 }
 
 impl PhotonMapping {
-    pub fn new(world: &World, maps: Arc<PhotonMaps>, settings: &PhotonSettings, max_depth: u32) -> Self {
-        Self { maps, settings: settings.clone(), max_depth, lanes: PathLanes::new(world).map(Box::new) }
+    pub fn new(
+        world: &World,
+        maps: Arc<PhotonMaps>,
+        settings: &PhotonSettings,
+        max_depth: u32,
+        max_radius: f32,
+    ) -> Self {
+        let lanes = PathLanes::new(world).map(Box::new);
+        Self { maps, max_radius, settings: settings.clone(), max_depth, lanes }
     }
 
     pub fn scratch(&self) -> PhotonScratch {
@@ -113,7 +122,8 @@ impl PhotonMapping {
     }
 
     fn renderer<'a>(&'a self, scope: PathScope<'a>) -> PhotonRenderer<'a> {
-        PhotonRenderer { scope, maps: &self.maps, settings: &self.settings, max_depth: self.max_depth }
+        let (maps, max_radius) = (&*self.maps, self.max_radius);
+        PhotonRenderer { scope, maps, max_radius, settings: &self.settings, max_depth: self.max_depth }
     }
 }
 
@@ -121,6 +131,7 @@ struct PhotonRenderer<'a> {
     /// The world as the path being traced sees it.
     scope: PathScope<'a>,
     maps: &'a PhotonMaps,
+    max_radius: f32,
     settings: &'a PhotonSettings,
     max_depth: u32,
 }
@@ -250,14 +261,14 @@ impl PhotonRenderer<'_> {
 
     /// The caustic map's estimate at `hit`.
     fn caustic(&self, hit: &Hit, wo: Vec3, facing: Vec3, bsdf: &Bsdf, scratch: &mut PhotonScratch) -> Rgb {
-        let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
+        let (point, k, r) = (hit.surface.point, self.k(), self.max_radius);
         let PhotonScratch { neighbours, queries } = scratch;
         estimate(&self.maps.caustic, point, facing, wo, bsdf, k, r, neighbours, queries)
     }
 
     /// The global map's estimate at `hit`.
     fn global(&self, hit: &Hit, wo: Vec3, facing: Vec3, bsdf: &Bsdf, scratch: &mut PhotonScratch) -> Rgb {
-        let (point, k, r) = (hit.surface.point, self.k(), self.maps.max_radius);
+        let (point, k, r) = (hit.surface.point, self.k(), self.max_radius);
         let PhotonScratch { neighbours, queries } = scratch;
         estimate(&self.maps.global, point, facing, wo, bsdf, k, r, neighbours, queries)
     }
@@ -266,6 +277,7 @@ impl PhotonRenderer<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::integrators::photon_map::maps::resolve_max_radius;
     use crate::render::settings::RenderSettings;
     use crate::render::world::camera::{CameraModel, TileRect};
     use crate::render::world::rng::PassStreams;
@@ -291,8 +303,9 @@ mod tests {
                     final_gather_rays: 3,
                     ..PhotonSettings::default()
                 };
-                let maps = PhotonMaps::build_until(&world, &settings, 3, 8, visible_radius, &|| true).expect("maps");
-                let photon = PhotonMapping::new(&world, Arc::new(maps), &settings, 8);
+                let maps = PhotonMaps::build_until(&world, &settings, 3, 8, &|| true).expect("maps");
+                let max_radius = resolve_max_radius(visible_radius, &settings);
+                let photon = PhotonMapping::new(&world, Arc::new(maps), &settings, 8, max_radius);
                 let rect = TileRect { x: 3, y: 2, width: 21, height: 9 };
                 let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(2, 9) };
                 let (mut expected_counters, mut scratch) = (Counters::default(), photon.scratch());
@@ -309,7 +322,7 @@ mod tests {
                 for lanes in [true, false] {
                     let scalar = PhotonMapping {
                         lanes: None,
-                        ..PhotonMapping::new(&world, photon.maps.clone(), &photon.settings, 8)
+                        ..PhotonMapping::new(&world, photon.maps.clone(), &photon.settings, 8, max_radius)
                     };
                     let renderer = if lanes { &photon } else { &scalar };
                     let (mut out, mut counters) = (vec![Rgb::splat(-1.0); tile.len()], Counters::default());

@@ -1,7 +1,8 @@
 //! Photon maps on disk, so the expensive pass can be reused: a small header
-//! (format version, the scene's content key, a key of the photon settings,
-//! the gather radius), both trees in heap order, little-endian, and a
-//! checksum of everything before it. A map for another scene, other
+//! (format version, the scene's content key, a key of the photon settings),
+//! both trees in heap order, little-endian, and a checksum of everything
+//! before it. The gather radius is not the map's: the render resolves it
+//! from its own settings and scene. A map for another scene, other
 //! settings or another format version is refused, saying which; so is a
 //! damaged one, before anything renders with it: the checksum catches bit
 //! flips, and each photon and the trees' order are checked as they are read.
@@ -20,8 +21,10 @@ use crate::render::PhotonSettings;
 pub const MAGIC: &[u8; 8] = b"GIPHOTON";
 /// 2: giant emitters emit only from the cap the camera can see.
 /// 3: a checksum at the end.
-pub const FORMAT_VERSION: u32 = 3;
-const HEADER_BYTES: u64 = 8 + 4 + 8 + 8 + 4;
+/// 4: no gather radius (a file's could only be wrong: the render's settings
+/// and scene say it).
+pub const FORMAT_VERSION: u32 = 4;
+const HEADER_BYTES: u64 = 8 + 4 + 8 + 8;
 const MAP_HEADER_BYTES: u64 = 16;
 const PHOTON_BYTES: u64 = 28;
 
@@ -116,7 +119,6 @@ pub fn save_photon_maps(
         put(out, &FORMAT_VERSION.to_le_bytes())?;
         put(out, &scene_key.to_le_bytes())?;
         put(out, &settings_key.to_le_bytes())?;
-        put(out, &maps.max_radius.to_le_bytes())?;
         for (tree, stats) in [(&maps.global, &maps.stats.global), (&maps.caustic, &maps.stats.caustic)] {
             put(out, &stats.emitted.to_le_bytes())?;
             put(out, &(tree.len() as u64).to_le_bytes())?;
@@ -205,6 +207,14 @@ impl RawMap {
                 .map_err(|what| damaged(format!("photon {i} of the {name} map has {what}")))?;
             photons.push(photon);
         }
+        // Photons leave their lights in directions of their own: no traced
+        // map of two or more has them all land on one point
+        if let Some(first) = photons.first() {
+            if photons.len() > 1 && photons.iter().all(|p| p.position == first.position) {
+                let n = photons.len();
+                return Err(damaged(format!("all {n} photons of the {name} map lie at one point")));
+            }
+        }
         let tree = PhotonKdTree::from_heap_order(photons)
             .map_err(|i| damaged(format!("photon {i} of the {name} map is out of the tree's order")))?;
         let stats = MapStats {
@@ -250,7 +260,6 @@ fn load_bounded(
     if input.u64()? != settings_key {
         return Err(PhotonFileError::OtherSettings { path: path.to_owned() });
     }
-    let max_radius = f32::from_bits(input.u32()?);
     let (global, caustic) = (input.map("global")?, input.map("caustic")?);
     // The checksum first: a flipped bit is said as what it is, whatever it hit
     let computed = input.sum.finish();
@@ -261,17 +270,9 @@ fn load_bounded(
         return Err(input.damaged("its checksum does not match its contents"));
     }
     let damaged = |reason: String| PhotonFileError::Damaged { path: path.to_owned(), reason };
-    if !(max_radius.is_finite() && max_radius > 0.0) {
-        return Err(damaged(format!("its gather radius is {max_radius}")));
-    }
     let (global, global_stats) = global.tree("global", damaged)?;
     let (caustic, caustic_stats) = caustic.tree("caustic", damaged)?;
-    Ok(PhotonMaps {
-        global,
-        caustic,
-        stats: PhotonMapStats { global: global_stats, caustic: caustic_stats },
-        max_radius,
-    })
+    Ok(PhotonMaps { global, caustic, stats: PhotonMapStats { global: global_stats, caustic: caustic_stats } })
 }
 
 #[cfg(test)]
@@ -313,7 +314,6 @@ mod tests {
                 global: MapStats { emitted: 50, ..MapStats::default() },
                 caustic: MapStats { emitted: 40, ..MapStats::default() },
             },
-            max_radius: 0.5,
         }
     }
 
@@ -327,12 +327,12 @@ mod tests {
         save_photon_maps(&maps_of(5, 3), 1, 2, &path).unwrap();
         let size = std::fs::metadata(&path).unwrap().len();
         assert_eq!(size, HEADER_BYTES + 2 * MAP_HEADER_BYTES + 8 * PHOTON_BYTES + 8);
-        assert_eq!((HEADER_BYTES, MAP_HEADER_BYTES, PHOTON_BYTES), (32, 16, 28));
+        assert_eq!((HEADER_BYTES, MAP_HEADER_BYTES, PHOTON_BYTES), (28, 16, 28));
         let loaded = load_photon_maps(&path, 1, 2).unwrap();
         assert_eq!((loaded.global.len(), loaded.caustic.len()), (5, 3));
         assert_eq!((loaded.stats.global.depth, loaded.stats.caustic.depth), (3, 2));
         assert_eq!((loaded.stats.global.bytes, loaded.stats.caustic.stored), (5 * 28, 3));
-        assert_eq!((loaded.stats.global.emitted, loaded.stats.caustic.emitted, loaded.max_radius), (50, 40, 0.5));
+        assert_eq!((loaded.stats.global.emitted, loaded.stats.caustic.emitted), (50, 40));
         // A map with no photons (a scene with nothing specular has no caustics)
         save_photon_maps(&maps_of(4, 0), 1, 2, &path).unwrap();
         let loaded = load_photon_maps(&path, 1, 2).unwrap();
@@ -344,7 +344,7 @@ mod tests {
     /// files: nothing is written to the disk.
     #[test]
     fn files_up_to_two_full_maps_are_opened_and_larger_ones_refused() {
-        const TWO_FULL_MAPS: u64 = 32 + 2 * (16 + 200_000_000 * 28) + 8;
+        const TWO_FULL_MAPS: u64 = 28 + 2 * (16 + 200_000_000 * 28) + 8;
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("huge.photons");
         let file = std::fs::File::create(&path).unwrap();
@@ -389,17 +389,23 @@ mod tests {
         assert!(refused.contains("the global map claims 5 photons, more than the 4 a map may hold"), "{refused}");
     }
 
-    /// A gather radius of 0 (or below) is refused even in a file whose
-    /// checksum holds: every estimate would divide by it.
+    /// A map whose photons were all moved to one point, its checksum made
+    /// anew, is refused: no traced map is that.
     #[test]
-    fn a_file_with_no_gather_radius_is_refused() {
+    fn a_map_of_photons_at_one_point_is_refused() {
         let dir = tempfile::tempdir().unwrap();
-        for radius in [0.0, -0.5] {
-            let path = dir.path().join(format!("maps-{radius}.photons"));
-            let maps = PhotonMaps { max_radius: radius, ..maps_of(2, 1) };
-            save_photon_maps(&maps, 1, 2, &path).unwrap();
-            let refused = load_photon_maps(&path, 1, 2).unwrap_err().to_string();
-            assert!(refused.contains(&format!("its gather radius is {radius}")), "{refused}");
-        }
+        let path = dir.path().join("maps.photons");
+        let at_one_point = |n: usize| {
+            let photons = (0..n).map(|_| Photon::new(glam::Vec3::new(1.0, 0.5, 0.0), -glam::Vec3::Y, [1.0; 3]));
+            PhotonKdTree::build(photons.collect())
+        };
+        let maps = PhotonMaps { global: at_one_point(5), ..maps_of(0, 3) };
+        save_photon_maps(&maps, 1, 2, &path).unwrap();
+        let refused = load_photon_maps(&path, 1, 2).unwrap_err().to_string();
+        assert!(refused.contains("all 5 photons of the global map lie at one point"), "{refused}");
+        // One photon alone is a map
+        let maps = PhotonMaps { global: at_one_point(1), ..maps_of(0, 3) };
+        save_photon_maps(&maps, 1, 2, &path).unwrap();
+        assert!(load_photon_maps(&path, 1, 2).is_ok());
     }
 }

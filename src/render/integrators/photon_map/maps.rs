@@ -67,8 +67,6 @@ pub struct PhotonMaps {
     pub global: PhotonKdTree,
     pub caustic: PhotonKdTree,
     pub stats: PhotonMapStats,
-    /// Largest gather radius (resolved from the settings and the scene).
-    pub max_radius: f32,
 }
 
 /// The gather radius when the settings leave it to the scene: a few percent
@@ -82,9 +80,9 @@ pub fn resolve_max_radius(visible_radius: f32, settings: &PhotonSettings) -> f32
 }
 
 impl PhotonMaps {
-    /// Trace both maps; `visible_radius` sets the default gather radius.
-    pub fn build(world: &World, settings: &PhotonSettings, seed: u64, max_depth: u32, visible_radius: f32) -> Self {
-        let built = Self::build_until(world, settings, seed, max_depth, visible_radius, &|| true);
+    /// Trace both maps.
+    pub fn build(world: &World, settings: &PhotonSettings, seed: u64, max_depth: u32) -> Self {
+        let built = Self::build_until(world, settings, seed, max_depth, &|| true);
         built.expect("a build that is never abandoned")
     }
 
@@ -95,7 +93,6 @@ impl PhotonMaps {
         settings: &PhotonSettings,
         seed: u64,
         max_depth: u32,
-        visible_radius: f32,
         keep_going: &(dyn Fn() -> bool + Sync),
     ) -> Option<Self> {
         let build = |kind: MapKind, count: u32| -> Option<(PhotonKdTree, MapStats)> {
@@ -120,12 +117,7 @@ impl PhotonMaps {
         };
         let (global, global_stats) = build(MapKind::Global, settings.global_photons)?;
         let (caustic, caustic_stats) = build(MapKind::Caustic, settings.caustic_photons)?;
-        Some(Self {
-            global,
-            caustic,
-            stats: PhotonMapStats { global: global_stats, caustic: caustic_stats },
-            max_radius: resolve_max_radius(visible_radius, settings),
-        })
+        Some(Self { global, caustic, stats: PhotonMapStats { global: global_stats, caustic: caustic_stats } })
     }
 }
 
