@@ -98,8 +98,6 @@ pub const STORED_PHOTONS: u64 = 200_000_000;
 pub const TEXT_FILE_BYTES: u64 = 16 << 20;
 /// The reference cache's size; the least recently used go beyond it.
 pub const REFERENCE_CACHE_BYTES: u64 = 512 << 20;
-/// Render threads of the studio's background reference.
-pub const REFERENCE_THREADS: Limit<usize> = Limit::inclusive(1, 256);
 
 /// The pixel count of `width × height`, refused beyond `IMAGE_PIXELS`.
 pub fn check_image_size(width: u32, height: u32) -> Result<(), OutOfRange> {

@@ -388,7 +388,8 @@ fn a_photon_map_claiming_billions_of_photons_is_refused_not_allocated() {
         .unwrap();
     assert_exit(&make, 0);
     let mut bytes = std::fs::read(&maps).unwrap();
-    bytes[40..48].copy_from_slice(&(1u64 << 34).to_le_bytes());
+    // The global map's photon count: after the 28-byte header and its emitted count
+    bytes[36..44].copy_from_slice(&(1u64 << 34).to_le_bytes());
     std::fs::write(&maps, &bytes).unwrap();
     let output = gi_studio()
         .args(["render", "assets/scenes/caustics.ron", "--algo", "photon", "--global-photons", "500"])

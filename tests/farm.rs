@@ -192,7 +192,7 @@ fn the_commands_shard_merge_and_write_the_farms_scripts() {
     assert_eq!(code, Some(1), "{text}");
     assert!(text.contains("small.exr is 8×4 and") && text.contains("whole.exr is 24×18"), "{text}");
     let (code, text) = run(&["merge", "part-0.exr", "-o", "half.exr"]);
-    assert_eq!((code, text.contains("shards 1 of 2 are missing")), (Some(1), true), "{text}");
+    assert_eq!((code, text.contains("shard 1 of 2 is missing")), (Some(1), true), "{text}");
     let (code, text) = run(&["render", &scene, "-o", "x.exr", "--shard", "0/2", "--time", "1"]);
     assert_eq!((code, text.contains("--shard needs --spp")), (Some(1), true), "{text}");
 

@@ -55,22 +55,21 @@ fn reference(image: LinearImage, variance: Option<LinearImage>, spp: u32) -> Ref
 
 /// At 64 spp, relMSE against a rough reference, corrected for that
 /// reference's variance, is within 15% of relMSE against a 4096-spp
-/// reference: of 64 spp on lights.ron (uncorrected, twice it), of 256 on
-/// the Cornell box (uncorrected, a quarter more). At 64 against 64 the
-/// box's fireflies in the reference's r², relMSE's denominator, bias the
-/// terms (1.48), which is why the studio measures against a background
-/// reference only once it has four times the pane's passes. And the film's
-/// own estimate of its relMSE (from its odd and even halves, no reference)
-/// is within 25% on lights.ron and errs on the side of too much on the
-/// Cornell box (measured 1.45; it stands in only until the background
-/// reference arrives).
+/// reference: of 64 spp on lights.ron (uncorrected, twice it), of 64 and of
+/// 256 on the Cornell box (uncorrected, a half and a quarter more). At 64
+/// against 64 the box's fireflies in the reference's r², relMSE's
+/// denominator, biased the terms (1.48) until the denominator became the
+/// reference smoothed within its own noise. And the film's own estimate of
+/// its relMSE (from its odd and even halves, no reference) is within 25% on
+/// lights.ron and errs on the side of too much on the Cornell box
+/// (measured 1.45; it stands in only until the background reference is
+/// good enough to measure against).
 #[test]
 fn own_noise_and_a_noisy_reference_corrected_measure_the_true_error() {
     // (preset, the rough reference's spp, what its noise adds at least, the
-    // own estimate's bounds); measured: lights corrected 0.98 of the truth
-    // at 64 against 64 (raw 2.03), cornell 1.08 at 256 (raw 1.27)
+    // own estimate's bounds)
     for (preset, rough_spp, raw_at_least, own_low, own_high) in
-        [("cornell", 256, 1.15, 0.8, 1.75), ("lights", 64, 1.5, 0.8, 1.25)]
+        [("cornell", 64, 1.3, 0.8, 1.75), ("cornell", 256, 1.1, 0.8, 1.75), ("lights", 64, 1.5, 0.8, 1.25)]
     {
         let (converged, converged_variance, _) = render(preset, 4096, 101);
         let truth = reference(converged, Some(converged_variance), 4096);
@@ -85,8 +84,9 @@ fn own_noise_and_a_noisy_reference_corrected_measure_the_true_error() {
         assert!((ratio - 1.0).abs() < 0.15, "{preset}: corrected {:.4e}, true {true_error:.4e}", corrected.rel_mse);
         // Its noise adds about 64/spp of the test's
         assert!(raw.rel_mse > raw_at_least * true_error, "{preset}: raw {:.4e}", raw.rel_mse);
+        // What the correction took off is the reference's own noise
         let floor = corrected.noise_floor.expect("a reference with variance has a noise floor");
-        assert!((raw.rel_mse - corrected.rel_mse - floor).abs() < 1e-9 * raw.rel_mse.max(1.0));
+        assert!(floor > 0.0 && floor < raw.rel_mse, "{preset}: floor {floor:.4e}, raw {:.4e}", raw.rel_mse);
 
         let own = stats.noise.expect("path tracing estimates its own noise").rel_mse / true_error;
         assert!((own_low..own_high).contains(&own), "{preset}: own estimate {own:.3} of the true error");

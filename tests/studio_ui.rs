@@ -602,8 +602,9 @@ fn a_screenshot_run_never_touches_the_saved_state() {
 }
 
 /// Saved settings no render can use (a pane of 100000², k = 2³²−1, tiles
-/// of 0, a NaN exposure, 100000 reference threads) fall back to defaults
-/// with a notice; the studio starts and renders.
+/// of 0, a NaN exposure) fall back to defaults with a notice; the studio
+/// starts and renders. A field an earlier version saved (100000 reference
+/// threads) is passed over.
 #[test]
 fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
     let mut storage = MemoryStorage::default();
@@ -624,19 +625,19 @@ fn unusable_saved_settings_fall_back_to_defaults_with_a_notice() {
         exposures: vec![f32::NAN, 1.0],
         show_plots: false,
         recent: Vec::new(),
-        reference_threads: 100_000,
     };
-    storage.set_string("studio", ron::to_string(&saved).unwrap());
+    let text = ron::to_string(&saved).unwrap();
+    let earlier = format!("{}, reference_threads: 100000)", text.trim_end_matches(')'));
+    storage.set_string("studio", earlier);
     let mut app = StudioApp::new(&egui::Context::default(), Some(&storage), &test_args());
     assert_eq!(app.panes().count(), 2);
     let first = app.panes().list()[0].settings();
     assert!(first.problems().is_empty(), "{:?}", first.problems());
     assert!(first.width <= 4096 && first.tile_size == 32);
-    assert_eq!(app.references().threads(), 1);
     assert_eq!(*app.panes().list()[1].settings(), fine);
     assert_eq!((app.panes().list()[0].exposure(), app.panes().list()[1].exposure()), (0.0, 1.0));
     assert!(
-        ["pane 1's saved size", "exposure", "reference threads"].iter().all(|s| app.messages().status.contains(s)),
+        ["pane 1's saved size", "exposure"].iter().all(|s| app.messages().status.contains(s)),
         "{}",
         app.messages().status
     );
@@ -684,10 +685,10 @@ fn an_edited_scene_is_measured_against_a_reference_made_in_the_background() {
         |app| matches!(app.panes().list()[0].state().latest_error(), Some(PaneError::Measured(e)) if e.rel_mse.is_finite()),
     );
     // The label shows the measured figure, ± its standard error. A later
-    // pass may fall back to the pane's own noise for a while (a reference
-    // still rendering measures only panes with a quarter of its passes),
-    // so the frames are looked at until one shows it: at the latest once
-    // the reference is done, the figure stays measured
+    // pass may fall back to the pane's own noise for a while (while the
+    // reference's noise is more than three times the pane's error), so the
+    // frames are looked at until one shows it: at the latest once the
+    // reference is done, the figure stays measured
     let shown = (0..60_000).any(|_| {
         harness.step();
         std::thread::sleep(std::time::Duration::from_millis(2));
@@ -707,10 +708,16 @@ fn an_edited_scene_is_measured_against_a_reference_made_in_the_background() {
     step_long_until(&mut harness, |app| app.references().source() == Some(&Source::BuiltIn));
     harness.run_steps(2);
     harness.get_by_label_contains("built in");
-    // Redone: the kept one, from the cache
+    // Redone: the kept one, from the cache, saying how converged it is
     harness.state_mut().edit_scene(small);
     step_long_until(&mut harness, |app| app.references().source() == Some(&Source::Cache));
     assert_eq!(kept(cache.path()), 1, "nothing rendered again");
+    harness.run_steps(2);
+    harness.get_by_label_contains("from the cache (path, 4096 of 4096 spp, its own relMSE");
+    // …and can be rendered again on the user's word
+    harness.get_by_label("Render again").click();
+    harness.run_steps(2);
+    assert!(matches!(harness.state().references().source(), Some(Source::Rendering(p)) if p.running));
 }
 
 /// A BDPT pane's "Strategies" button opens the strategy view without

@@ -16,6 +16,8 @@ pub struct ScreenshotRequest {
     pub crop: Option<egui::Rect>,
     /// Wait until every pane has this many passes (the --screenshot mode).
     pub after_passes: Option<u32>,
+    /// Or until this moment (`--quit-after-seconds`).
+    pub at: Option<std::time::Instant>,
     pub quit_after: bool,
     /// Frames to wait first, so the dialog that asked for it is gone.
     pub delay: u8,
@@ -38,6 +40,7 @@ impl ScreenshotRequest {
             path,
             crop,
             after_passes: None,
+            at: None,
             quit_after: false,
             delay: 2,
             requested: false,
@@ -92,10 +95,13 @@ pub struct Captured {
 }
 
 impl Capture {
-    /// `--screenshot PATH`: once every pane has `passes` passes, then quit.
-    pub fn headless(path: PathBuf, passes: u32) -> Self {
+    /// `--screenshot PATH`: once every pane has `passes` passes (or, given
+    /// `seconds`, once that long has passed), then quit.
+    pub fn headless(path: PathBuf, passes: u32, seconds: Option<f64>) -> Self {
+        let at = seconds.map(|s| std::time::Instant::now() + std::time::Duration::from_secs_f64(s));
         let request = ScreenshotRequest {
-            after_passes: Some(passes.max(1)),
+            after_passes: Some(passes.max(1)).filter(|_| at.is_none()),
+            at,
             quit_after: true,
             delay: 0,
             ..ScreenshotRequest::new(path, None)
@@ -117,6 +123,10 @@ impl Capture {
     pub fn step(&mut self, ctx: &egui::Context, ready: impl Fn(u32) -> bool) -> Option<Captured> {
         let request = self.request.as_mut()?;
         let is_ready = request.after_passes.is_none_or(ready);
+        let is_ready = is_ready && request.at.is_none_or(|at| std::time::Instant::now() >= at);
+        if let Some(at) = request.at {
+            ctx.request_repaint_after(at.saturating_duration_since(std::time::Instant::now()));
+        }
         let result = request.step(ctx, is_ready)?;
         let quit = request.quit_after;
         self.request = None;

@@ -56,6 +56,14 @@ pub struct StudioArgs {
     pub screenshot: Option<PathBuf>,
     #[arg(long, default_value_t = 2, value_parser = |s: &str| crate::limits::SAMPLES_PER_PIXEL.parse(s))]
     pub quit_after_passes: u32,
+    /// With --screenshot: take it this many seconds after the start, however
+    /// many passes the panes have (instead of --quit-after-passes).
+    #[arg(long, value_parser = |s: &str| crate::limits::SECONDS.parse(s))]
+    pub quit_after_seconds: Option<f64>,
+    /// With --screenshot: also save each pane's linear image there, as
+    /// pane-1.exr, pane-2.exr… (for measuring what the panes showed).
+    #[arg(long, value_name = "DIR")]
+    pub save_panes: Option<PathBuf>,
     /// Replace a screenshot file that GI Studio did not write.
     #[arg(long)]
     pub force: bool,

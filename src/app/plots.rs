@@ -37,7 +37,9 @@ pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane], panel_height: f32) {
             for (i, pane) in panes.iter().enumerate() {
                 let (mut line, mut low, mut high, mut estimated) = (Vec::new(), Vec::new(), Vec::new(), false);
                 for record in &pane.state().history {
-                    let Some(error) = record.error.filter(|e| e.rel_mse() > 0.0) else { continue };
+                    // A bound is not a figure to draw
+                    let drawn = |e: &PaneError| e.rel_mse() > 0.0 && !matches!(e, PaneError::Below(_));
+                    let Some(error) = record.error.filter(drawn) else { continue };
                     let t = record.seconds.max(1e-6).log10();
                     line.push([t, error.rel_mse().log10()]);
                     // ±1 standard error, where it stays above zero
@@ -46,7 +48,7 @@ pub fn plots_ui(ui: &mut egui::Ui, panes: &[Pane], panel_height: f32) {
                     high.push([t, (error.rel_mse() + spread).log10()]);
                     match error {
                         PaneError::Measured(e) => floor = e.noise_floor.or(floor),
-                        PaneError::Estimated(_) => estimated = true,
+                        PaneError::Estimated(_) | PaneError::Below(_) => estimated = true,
                     }
                 }
                 let style = if estimated { LineStyle::dashed_loose() } else { LineStyle::Solid };

@@ -13,20 +13,25 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender};
 use eframe::egui;
 
-use super::widgets::number;
-
+use crate::analysis::metrics::rel_mse_against;
 use crate::analysis::reference::{
     embedded, reference_key, reference_method, reference_settings, reference_size, Reference, ReferenceCache,
-    ReferenceInfo, ReferenceMethod,
+    ReferenceInfo, ReferenceMethod, REFERENCE_PASSES,
 };
-use crate::limits;
 use crate::render::film::NoiseEstimate;
-use crate::render::{Algorithm, LinearImage, RenderEvent, RenderJob, RenderSession, Workers};
+use crate::render::{Algorithm, LinearImage, RenderEvent, RenderJob, RenderSession, Weight, Workers};
 use crate::scene::ValidScene;
 
 /// A reference abandoned after this many passes is kept in the cache: an
 /// edit undone finds it, rough as it is.
 const KEPT_PASSES: u32 = 16;
+
+/// A background reference is young while its own relMSE is above this:
+/// it then takes turns on the threads as all the panes together, since a
+/// reference noisier than a few times a pane's error cannot measure it
+/// (`pane::NOISE_OVER_ERROR`), and panes of the presets reach about this
+/// much in their first half minute.
+const YOUNG_NOISE: f64 = 2e-3;
 
 /// Where the current reference comes from.
 #[derive(Clone, Debug, PartialEq)]
@@ -71,6 +76,8 @@ struct Current {
     /// waits for to see an error on an edited scene).
     followed_at: Instant,
     first_estimate_after: Option<Duration>,
+    /// A found reference's own relMSE (from its variance), worked out once.
+    found_noise: Option<f64>,
 }
 
 enum Request {
@@ -131,9 +138,11 @@ fn answer(cache: &Option<ReferenceCache>, request: Request, replies: &Sender<Rep
 
 pub struct References {
     current: Option<Current>,
-    threads: usize,
-    workers: Option<Workers>,
+    /// The background render's session, on the panes' workers.
     session: Option<RenderSession>,
+    /// Its share of the workers, and that share while it is young.
+    weight: Weight,
+    young_weight: u32,
     generation: u64,
     /// The image and variance assembled from the background render's tiles.
     image: LinearImage,
@@ -141,13 +150,13 @@ pub struct References {
     requests: Sender<Request>,
     replies: Receiver<Reply>,
     store: Option<JoinHandle<()>>,
-    ctx: egui::Context,
 }
 
 impl References {
-    /// With `threads` threads for background references and `cache` to keep
-    /// them in. Errors (threads refused) are said where the reference shows.
-    pub fn new(ctx: &egui::Context, threads: usize, cache: Option<ReferenceCache>) -> Self {
+    /// Rendering on `workers` (the panes' own, in turns with them; None:
+    /// the OS refused them), keeping references in `cache`. Errors are said
+    /// where the reference shows.
+    pub fn new(ctx: &egui::Context, workers: Option<&Workers>, cache: Option<ReferenceCache>) -> Self {
         let (requests, requests_rx) = crossbeam_channel::unbounded();
         let (replies_tx, replies) = crossbeam_channel::unbounded();
         let notify = ctx.clone();
@@ -155,21 +164,20 @@ impl References {
             .name("references".into())
             .spawn(move || store_loop(cache, requests_rx, replies_tx, notify))
             .ok();
-        let mut references = Self {
+        let repaint = ctx.clone();
+        let notify: crate::render::engine::Notify = Arc::new(move |news| super::status::repaint(&repaint, news));
+        Self {
             current: None,
-            threads: 0,
-            workers: None,
-            session: None,
+            session: workers.and_then(|w| RenderSession::new(w, Some(notify)).ok()),
+            weight: Weight::default(),
+            young_weight: 1,
             generation: 0,
             image: LinearImage::new(0, 0),
             variance: LinearImage::new(0, 0),
             requests,
             replies,
             store,
-            ctx: ctx.clone(),
-        };
-        references.set_threads(threads);
-        references
+        }
     }
 
     /// The reference the panes are measured against now.
@@ -182,32 +190,10 @@ impl References {
         self.current.as_ref().map(|c| &c.source)
     }
 
-    pub fn threads(&self) -> usize {
-        self.threads
-    }
-
-    /// Render background references on `threads` threads (from the next
-    /// one; a running one restarts on them).
-    pub fn set_threads(&mut self, threads: usize) {
-        let threads = threads.clamp(limits::REFERENCE_THREADS.min, limits::REFERENCE_THREADS.max);
-        if threads == self.threads && self.workers.is_some() {
-            return;
-        }
-        self.threads = threads;
-        self.session = None;
-        let repaint = self.ctx.clone();
-        let notify: crate::render::engine::Notify = Arc::new(move |news| super::status::repaint(&repaint, news));
-        self.workers = match Workers::new(threads) {
-            Ok(workers) => {
-                self.session = RenderSession::new(&workers, Some(notify)).ok();
-                Some(workers)
-            }
-            Err(_) => None,
-        };
-        let rendering = self.current.as_ref().is_some_and(|c| matches!(&c.source, Source::Rendering(p) if p.running));
-        if rendering {
-            self.render();
-        }
+    /// How many panes render beside it: while it is young, a background
+    /// reference takes turns on the threads as twice all of them together.
+    pub fn set_panes(&mut self, panes: usize) {
+        self.young_weight = 2 * panes.max(1) as u32;
     }
 
     /// Follow the document to `scene`, a new valid revision: its reference
@@ -236,6 +222,7 @@ impl References {
             source,
             followed_at,
             first_estimate_after: None,
+            found_noise: None,
         });
         if self.store.is_none() {
             // Without the thread nothing is found: render at once
@@ -299,6 +286,8 @@ impl References {
                     let Some(current) = self.current.as_mut().filter(|c| c.key == key) else { continue };
                     match reference {
                         Some(reference) => {
+                            let own = rel_mse_against(&reference.image, &reference).ok();
+                            current.found_noise = own.and_then(|e| e.noise_floor);
                             current.reference = Some(*reference);
                             current.source = if built_in { Source::BuiltIn } else { Source::Cache };
                         }
@@ -350,6 +339,8 @@ impl References {
                     if stats.noise.is_some() && current.first_estimate_after.is_none() {
                         current.first_estimate_after = Some(current.followed_at.elapsed());
                     }
+                    let young = stats.noise.is_none_or(|n| n.rel_mse > YOUNG_NOISE);
+                    self.weight.set(if young { self.young_weight } else { 1 });
                     let reference = assembled(current, &self.image, &self.variance);
                     current.reference = reference;
                 }
@@ -374,7 +365,7 @@ impl References {
     fn render(&mut self) {
         let Some(current) = &mut self.current else { return };
         let Some(session) = &self.session else {
-            current.source = Source::Unavailable(format!("could not start {} reference threads", self.threads));
+            current.source = Source::Unavailable("the render threads could not start".into());
             return;
         };
         let (width, height) = current.size;
@@ -383,6 +374,9 @@ impl References {
         let mut job = RenderJob::new(current.scene.clone(), settings);
         job.stream_variance = true;
         job.estimate_noise = true;
+        job.reference = true;
+        self.weight.set(self.young_weight);
+        job.weight = self.weight.clone();
         self.generation = session.start(job);
         self.image = LinearImage::new(width, height);
         self.variance = LinearImage::new(width, height);
@@ -413,22 +407,23 @@ impl References {
     }
 
     /// One line: where the reference comes from, how it was made, how far
-    /// it has come; the threads it renders on; stop or go on.
+    /// it has come; stop it, or render it (again).
     pub fn reference_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             ui.label(self.describe());
-            let mut threads = self.threads;
-            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-            let slider = number(&mut threads).range(1..=cores.max(1)).prefix("reference threads ");
-            if ui.add(slider).on_hover_text("Threads that render a reference in the background").changed() {
-                self.set_threads(threads);
-            }
             let button = match self.source() {
-                Some(Source::Rendering(p)) => Some(if p.running { "Stop" } else { "Render again" }),
+                Some(Source::Rendering(p)) if p.running => {
+                    Some(("Stop", "Stop rendering; what it has stays the reference"))
+                }
+                Some(Source::Rendering(_) | Source::Cache | Source::Promoted { .. }) => {
+                    Some(("Render again", "Render this scene's reference afresh in the background"))
+                }
                 _ => None,
             };
-            if button.is_some_and(|label| ui.small_button(label).clicked()) {
-                self.toggle();
+            if let Some((label, hint)) = button {
+                if ui.small_button(label).on_hover_text(hint).clicked() {
+                    self.toggle();
+                }
             }
         });
     }
@@ -443,7 +438,10 @@ impl References {
     /// What `reference_ui` says of the reference.
     pub fn describe(&self) -> String {
         let Some(current) = &self.current else { return "Reference: none (the scene is not valid)".into() };
-        let made = |r: &Reference| format!("{}, {} spp", r.info.algorithm, r.info.samples_per_pixel);
+        let made = |r: &Reference| {
+            let noise = current.found_noise.map_or(String::new(), |n| format!(", its own relMSE {n:.1e}"));
+            format!("{}, {} of {REFERENCE_PASSES} spp{noise}", r.info.algorithm, r.info.samples_per_pixel)
+        };
         match (&current.source, &current.reference) {
             (Source::Looking, _) => "Reference: looking…".into(),
             (Source::BuiltIn, Some(r)) => format!("Reference: built in ({})", made(r)),
@@ -481,7 +479,7 @@ fn assembled(current: &Current, image: &LinearImage, variance: &LinearImage) -> 
         seed: reference_settings(algorithm, 1, 1).seed,
         program_version: env!("CARGO_PKG_VERSION").into(),
     };
-    let variance = (algorithm.is_unbiased() && progress.passes >= 2).then(|| variance.clone());
+    let variance = (progress.passes >= 2).then(|| variance.clone());
     Some(Reference { image: image.clone(), variance, info })
 }
 

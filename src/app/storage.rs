@@ -24,26 +24,23 @@ pub struct Persisted {
     pub exposures: Vec<f32>,
     pub show_plots: bool,
     pub recent: Vec<PathBuf>,
-    /// Threads of the background reference.
-    pub reference_threads: usize,
 }
 
 impl Default for Persisted {
     fn default() -> Self {
-        Self { panes: Vec::new(), exposures: Vec::new(), show_plots: true, recent: Vec::new(), reference_threads: 1 }
+        Self { panes: Vec::new(), exposures: Vec::new(), show_plots: true, recent: Vec::new() }
     }
 }
 
 impl Persisted {
     /// What the studio keeps of its panes, panels and recent files.
-    pub fn of(panes: &Panes, show_plots: bool, recent: &[PathBuf], reference_threads: usize) -> Self {
+    pub fn of(panes: &Panes, show_plots: bool, recent: &[PathBuf]) -> Self {
         let panes = panes.list();
         Self {
             panes: panes.iter().map(|p| p.settings().clone()).collect(),
             exposures: panes.iter().map(Pane::exposure).collect(),
             show_plots,
             recent: recent.to_vec(),
-            reference_threads,
         }
     }
 }
@@ -62,7 +59,6 @@ pub struct Restored {
     pub exposures: Vec<f32>,
     pub show_plots: bool,
     pub recent: Vec<PathBuf>,
-    pub reference_threads: usize,
     pub notices: Vec<String>,
 }
 
@@ -92,11 +88,7 @@ impl Persisted {
             })
             .collect();
         let recent = self.recent.into_iter().take(RECENT_FILES).collect();
-        let reference_threads = limits::REFERENCE_THREADS.check(self.reference_threads).unwrap_or_else(|problem| {
-            notices.push(format!("the saved reference threads {problem}; 1 is used"));
-            1
-        });
-        Restored { panes, exposures, show_plots: self.show_plots, recent, reference_threads, notices }
+        Restored { panes, exposures, show_plots: self.show_plots, recent, notices }
     }
 }
 

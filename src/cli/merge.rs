@@ -9,7 +9,7 @@ use clap::Args;
 
 use super::outputs::Outputs;
 use super::shard::{load_parts, manifest_path, merge};
-use crate::analysis::metrics::{rel_mse, rmse, RelMseOptions};
+use crate::analysis::metrics::{rel_mse, rel_mse_against, rmse, RelMseOptions};
 use crate::analysis::reference::{info_path, reference_key_of, Reference, ReferenceCache, ReferenceInfo};
 use crate::fileio::SIGNATURE;
 use crate::render::image::ImageFormat;
@@ -125,7 +125,17 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
             reference.height
         );
     }
-    let relative = rel_mse(&image, &reference, RelMseOptions::default())?;
+    // A reference made by `gi-studio reference` (its metadata beside it)
+    // carries its variance: its own noise is taken off the figure
+    let relative = match Reference::load(&args.reference).ok().filter(|r| r.variance.is_some()) {
+        Some(stored) => {
+            let estimate = rel_mse_against(&image, &stored)?;
+            let floor = estimate.noise_floor.unwrap_or(0.0);
+            println!("the reference's own noise, taken off: {floor:.3e}");
+            estimate.rel_mse
+        }
+        None => rel_mse(&image, &reference, RelMseOptions::default())?,
+    };
     let largest = (image.pixels.iter().flatten())
         .zip(reference.pixels.iter().flatten())
         .map(|(a, b)| (a - b).abs())

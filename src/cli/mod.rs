@@ -32,7 +32,7 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Trace a scene's photon maps once and save them for `render --photon-map`.
     Photons(photons::PhotonsArgs),
-    /// Render converged path-traced references (EXR, with metadata beside them).
+    /// Render converged references (EXR with each pixel's variance, metadata beside it) by the method each scene needs.
     Reference(reference::ReferenceArgs),
     /// Speed against error: every algorithm for the same time budget, against references.
     Bench(bench::BenchArgs),

@@ -63,7 +63,8 @@ pub fn render_reference(
     name: &str,
     settings: &RenderSettings,
 ) -> Result<(Reference, PassStats)> {
-    let outcome = render_with_progress(workers, RenderJob::new(scene.clone(), settings.clone()))?;
+    let job = RenderJob { reference: true, ..RenderJob::new(scene.clone(), settings.clone()) };
+    let outcome = render_with_progress(workers, job)?;
     let stats = outcome.stats;
     Ok((reference_of(scene, name, settings, outcome), stats))
 }

@@ -19,7 +19,8 @@ pub mod unseen;
 pub mod world;
 
 pub use engine::{
-    render_blocking, render_blocking_on, PassStats, RenderEvent, RenderJob, RenderSession, Switch, TileUpdate, Workers,
+    render_blocking, render_blocking_on, PassStats, RenderEvent, RenderJob, RenderSession, Switch, TileUpdate, Weight,
+    Workers,
 };
 pub use image::LinearImage;
 pub use integrators::PhotonPassStats;

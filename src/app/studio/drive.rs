@@ -80,6 +80,7 @@ impl StudioApp {
     /// Render every pane afresh with the scene as it stands (after their
     /// settings changed).
     pub fn restart_all(&mut self) {
+        self.references.set_panes(self.panes.count());
         self.document.check();
         if let Some(scene) = self.document.valid().cloned() {
             self.panes.restart_all(&scene);

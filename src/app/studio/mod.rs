@@ -15,6 +15,7 @@ use super::commands::{Action, Command, Shown};
 use super::dialogs::Dialogs;
 use super::difference::Difference;
 use super::document::Document;
+use super::export::export_image;
 use super::files::DialogPurpose;
 use super::inspector::{inspector_ui, Selection};
 use super::keys::{input_commands, Gesture, WindowState};
@@ -45,6 +46,8 @@ pub struct StudioApp {
     state: StateKeeper,
     clock: FrameClock,
     gesture: Gesture,
+    /// Where a `--screenshot` run also saves each pane's image.
+    save_panes: Option<PathBuf>,
     /// The revision the reference follows.
     referenced_revision: u64,
     paused: bool,
@@ -72,15 +75,14 @@ impl StudioApp {
             None => ReferenceCache::open_default(),
         };
         let mut app = Self {
+            references: References::new(ctx, workers.as_ref(), reference_cache),
             panes: Panes::new(ctx, workers),
-            references: References::new(ctx, restored.reference_threads, reference_cache),
             document,
             selection: Selection::Camera,
             dialogs: Dialogs::new(autosave_offer, start_folder(&restored.recent)),
-            capture: args
-                .screenshot
-                .clone()
-                .map_or_else(Capture::default, |path| Capture::headless(path, args.quit_after_passes)),
+            capture: args.screenshot.clone().map_or_else(Capture::default, |path| {
+                Capture::headless(path, args.quit_after_passes, args.quit_after_seconds)
+            }),
             difference: Difference::default(),
             shown: Shown { plots: restored.show_plots, ..Shown::default() },
             recent: restored.recent,
@@ -89,6 +91,7 @@ impl StudioApp {
             state: StateKeeper::new(capture_only),
             clock: FrameClock::default(),
             gesture: Gesture::default(),
+            save_panes: args.save_panes.clone(),
             referenced_revision: 0,
             paused: false,
             ctx: ctx.clone(),
@@ -314,6 +317,15 @@ impl StudioApp {
             for (i, pane) in self.panes.list().iter().enumerate() {
                 println!("pane {}: {}", i + 1, pane.label());
             }
+            if let Some(folder) = &self.save_panes {
+                for (i, pane) in self.panes.list().iter().enumerate() {
+                    let path = folder.join(format!("pane-{}.exr", i + 1));
+                    match export_image(&pane.state().image, pane.exposure(), &path) {
+                        Ok(()) => println!("saved {}", path.display()),
+                        Err(e) => eprintln!("error: {e}"),
+                    }
+                }
+            }
             println!("{}", self.references.describe());
             if let Some(edits) = self.dialogs.offered_edits() {
                 println!("offered back: the last session's unsaved scene ({})", edits.join(", "));
@@ -365,7 +377,7 @@ impl eframe::App for StudioApp {
                 Autosave::Keep
             }
         };
-        let persisted = Persisted::of(&self.panes, self.shown.plots, &self.recent, self.references.threads());
+        let persisted = Persisted::of(&self.panes, self.shown.plots, &self.recent);
         if let Err(e) = write_state(storage, &persisted, autosave) {
             self.messages.fail(e);
         }

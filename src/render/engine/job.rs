@@ -3,7 +3,7 @@
 //! and tiles sent as events. A job stops within a tile of being abandoned:
 //! every tile checks the generation it belongs to.
 
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -39,10 +39,32 @@ pub struct RenderJob {
     /// Estimate the render's own relMSE (`PassStats::noise`, unbiased
     /// methods only) now and then: what a viewer without a reference shows.
     pub estimate_noise: bool,
+    /// Made as a reference: its variance is kept (odd and even passes
+    /// apart) whatever the method, as the errors measured against it take
+    /// its noise off. A consistent method's neighbouring passes (VCM's
+    /// radius shrinks slowly) are as good as independent for that.
+    pub reference: bool,
     /// Send what each strategy of a bidirectional method brings, now and
     /// then, while this is on (the studio's strategy view, which opens and
     /// closes while the job goes on).
     pub strategies: Switch,
+    /// Its share of workers it shares with other jobs (1 unless changed).
+    pub weight: Weight,
+}
+
+/// How many callers' worth of the shared workers a job takes, which its
+/// driver may change while it runs (`Share::weight`).
+#[derive(Clone, Debug, Default)]
+pub struct Weight(Arc<AtomicU32>);
+
+impl Weight {
+    pub fn set(&self, weight: u32) {
+        self.0.store(weight, Ordering::Relaxed);
+    }
+
+    pub fn get(&self) -> u32 {
+        self.0.load(Ordering::Relaxed).max(1)
+    }
 }
 
 /// A flag the driver turns on and off while a job runs.
@@ -72,7 +94,9 @@ impl RenderJob {
             stream_tiles: true,
             stream_variance: false,
             estimate_noise: false,
+            reference: false,
             strategies: Switch::default(),
+            weight: Weight::default(),
         }
     }
 }
@@ -154,7 +178,8 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
     // waited for other sessions' stages
     let mut busy = Duration::ZERO;
     let mut share = Share::default();
-    let halves = settings.algorithm().is_unbiased();
+    share.weight = job.weight.get();
+    let halves = settings.algorithm().is_unbiased() || job.reference;
     // The film is made in the job's time: its sums are written as it is
     // made (`Film::new`), which the first pass did before
     let ((mut film, prepared), took) = workers.run_in_turn(&mut share, || {
@@ -194,6 +219,7 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
             break;
         }
         let pass = settings.first_pass + stats.passes;
+        share.weight = job.weight.get();
         let (report, pass_time) = workers.run_in_turn(&mut share, || integrator.pass(&stage, &mut film, pass, context));
         let Some(report) = report else {
             return;

@@ -11,6 +11,6 @@ mod workers;
 
 pub use events::{Notify, PassStats, RenderEvent, TileUpdate};
 pub use heap::keep_freed_memory;
-pub use job::{RenderJob, Switch};
+pub use job::{RenderJob, Switch, Weight};
 pub use session::{render_blocking, render_blocking_on, RenderSession};
 pub use workers::Workers;

@@ -34,9 +34,19 @@ impl std::fmt::Debug for Workers {
 /// its stages): what decides whose turn is next.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Share {
-    /// The pool's time this caller has had, counted from where the least
-    /// served caller stood when it came (`Queue::arrive`).
+    /// The pool's time this caller has had, over its weight, counted from
+    /// where the least served caller stood when it came (`Queue::arrive`).
     had: Duration,
+    /// How many callers' worth of the pool it takes (0 counts as 1): the
+    /// studio's reference, while it is young, as much as all its panes.
+    pub weight: u32,
+}
+
+impl Share {
+    /// The caller had the pool for `took`: it counts as `took` over its weight.
+    fn spent(&mut self, took: Duration) {
+        self.had += took / self.weight.max(1);
+    }
 }
 
 /// The callers waiting for the pool, and whether one has it.
@@ -156,7 +166,7 @@ impl Workers {
         let result = self.pool.install(work);
         let took = start.elapsed();
         drop(turn);
-        share.had += took;
+        share.spent(took);
         (result, took)
     }
 }
@@ -199,7 +209,26 @@ mod tests {
     }
 
     fn share(seconds: u64) -> Share {
-        Share { had: Duration::from_secs(seconds) }
+        Share { had: Duration::from_secs(seconds), weight: 1 }
+    }
+
+    /// A caller of weight 3 beside one of weight 1, both with stages of a
+    /// second: three turns to one.
+    #[test]
+    fn a_weighted_caller_has_the_pool_as_often_as_its_weight_says() {
+        let mut queue = Queue::default();
+        let (mut heavy, mut light) = (Share { weight: 3, ..share(0) }, share(0));
+        let mut turns = [0; 2];
+        for _ in 0..40 {
+            let tickets = [queue.arrive(&mut heavy), queue.arrive(&mut light)];
+            let first = tickets.iter().position(|&t| queue.start(t)).expect("one of them starts");
+            queue.finish();
+            turns[first] += 1;
+            [&mut heavy, &mut light][first].spent(Duration::from_secs(1));
+            // Both ask afresh next round
+            queue.waiting.clear();
+        }
+        assert_eq!(turns, [30, 10], "turns of the heavy and the light caller");
     }
 
     #[test]
