@@ -154,7 +154,7 @@ fn shadow_rays(c: &mut Criterion) {
         let mut blocked = vec![false; shadows.len()];
         group.bench_function(format!("{name}/eight_at_a_time"), |b| {
             b.iter(|| {
-                lanes.shadows_blocked(&world, black_box(&shadows), &mut blocked);
+                lanes.shadows_blocked(black_box(&shadows), &mut blocked);
                 blocked.iter().filter(|&&b| b).count()
             })
         });

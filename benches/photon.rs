@@ -6,7 +6,7 @@ use std::hint::black_box;
 use std::num::NonZero;
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use gi_studio::render::integrators::photon_map::trace::{trace_photons, MapKind};
+use gi_studio::render::integrators::photon_map::trace::{trace_photons, MapKind, PhotonBatch};
 use gi_studio::render::integrators::photon_map::{Neighbours, Photon, PhotonKdTree};
 use gi_studio::render::world::rng::Sampler;
 use gi_studio::render::world::World;
@@ -98,7 +98,8 @@ fn photon_tracing(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(count));
     group.bench_function("caustics_global_photons", |b| {
-        b.iter(|| trace_photons(&world, MapKind::Indirect, count, 0, 3, 32).len())
+        let batch = PhotonBatch { kind: MapKind::Indirect, count, pass: 0, seed: 3, max_depth: 32 };
+        b.iter(|| trace_photons(&world, batch).len())
     });
     group.finish();
 }

@@ -9,7 +9,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use gi_studio::render::film::Film;
-use gi_studio::render::integrators::photon_map::trace::{trace_photons_until, MapKind, CHUNK};
+use gi_studio::render::integrators::path_lanes::PathLanes;
+use gi_studio::render::integrators::photon_map::trace::{trace_photons_until, MapKind, PhotonBatch, CHUNK};
 use gi_studio::render::integrators::{Integrator, PassObserver, Stage};
 use gi_studio::render::world::camera::{CameraModel, TileRect};
 use gi_studio::render::world::World;
@@ -282,7 +283,8 @@ fn a_cancel_waits_for_at_most_one_tile_or_chunk_a_worker() {
         settings.set_photons(20_000);
         let camera = CameraModel::new(&job.scene.camera, settings.width, settings.height);
         let (world, visible) = World::for_view(&job.scene, &camera, settings.width, settings.height);
-        let stage = Stage { world: &world, camera: &camera, settings: &settings };
+        let lanes = PathLanes::new(&world);
+        let stage = Stage { world: &world, camera: &camera, settings: &settings, lanes: lanes.as_ref() };
         let mut film = Film::new(settings.width, settings.height, settings.tile_size, false);
         let keep = Abandoning::new(usize::MAX);
         let mut integrator = Integrator::prepare(&stage, &film, visible, None, &keep).expect("prepared");
@@ -307,13 +309,12 @@ fn a_cancel_waits_for_at_most_one_tile_or_chunk_a_worker() {
     let count = 100 * CHUNK;
     let asked = std::sync::atomic::AtomicUsize::new(0);
     let mut photons = Vec::new();
+    let lanes = PathLanes::new(&world);
+    let batch = PhotonBatch { kind: MapKind::Global, count, pass: 0, seed: 1, max_depth: 8 };
     let all = trace_photons_until(
         &world,
-        MapKind::Global,
-        count,
-        0,
-        1,
-        8,
+        lanes.as_ref(),
+        batch,
         &|| {
             asked.fetch_add(1, Ordering::SeqCst);
             true
@@ -331,7 +332,7 @@ fn a_cancel_waits_for_at_most_one_tile_or_chunk_a_worker() {
             traced.fetch_add(go as usize, Ordering::SeqCst);
             go
         };
-        trace_photons_until(&world, MapKind::Global, count, 0, 1, 8, &keep_going, &mut photons)
+        trace_photons_until(&world, lanes.as_ref(), batch, &keep_going, &mut photons)
     });
     assert!(stopped.is_none(), "an abandoned trace gives no map");
     assert_eq!(traced.load(Ordering::SeqCst), 5, "only the chunks told to go on were traced");

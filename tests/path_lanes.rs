@@ -357,7 +357,7 @@ fn shadow_rays_in_lanes_are_blocked_as_one_at_a_time() {
         while at < shadows.len() {
             let end = (at + length).min(shadows.len());
             let mut got = vec![false; end - at];
-            lanes.shadows_blocked(&world, &shadows[at..end], &mut got);
+            lanes.shadows_blocked(&shadows[at..end], &mut got);
             assert_eq!(got, expected[at..end], "{name}: shadow rays {at}..{end}");
             (at, length) = (end, length % 27 + 1);
         }

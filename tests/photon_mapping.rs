@@ -13,7 +13,7 @@ use gi_studio::analysis::metrics::{rel_mse, RelMseOptions};
 use gi_studio::render::integrators::photon_map::file::{
     load_photon_maps, save_photon_maps, settings_key, PhotonFileError,
 };
-use gi_studio::render::integrators::photon_map::trace::{trace_photons, MapKind};
+use gi_studio::render::integrators::photon_map::trace::{trace_photons, MapKind, PhotonBatch};
 use gi_studio::render::integrators::photon_map::PhotonMaps;
 use gi_studio::render::world::camera::CameraModel;
 use gi_studio::render::world::World;
@@ -40,7 +40,8 @@ fn photons_on_a_plane_carry_the_analytic_share_of_a_point_lights_power() {
     // 2·10⁶ photons: a tenth of them land in the disc, a binomial share
     // with relative σ = √(0.9/(0.1·2·10⁶)) ≈ 0.21%, so the 1% bound below
     // is 4.7σ (with 4·10⁵ it was 2.1σ: one seed in thirty would fail)
-    let photons = trace_photons(&world, MapKind::All, 2_000_000, 0, 1, 4);
+    let photons =
+        trace_photons(&world, PhotonBatch { kind: MapKind::All, count: 2_000_000, pass: 0, seed: 1, max_depth: 4 });
     let within: f64 = photons
         .iter()
         .filter(|p| Vec3::new(p.position.x, 0.0, p.position.z).length() <= radius)
@@ -381,7 +382,10 @@ fn every_kind_of_map_changes_with_the_seed() {
     let world = World::new(&presets::preset("cornell").unwrap().unwrap());
     for kind in [MapKind::Global, MapKind::Caustic, MapKind::Indirect, MapKind::All] {
         let maps: Vec<Vec<[f32; 3]>> = (0..4)
-            .map(|seed| trace_photons(&world, kind, 2_000, 0, seed, 8).iter().map(|p| p.position.to_array()).collect())
+            .map(|seed| {
+                let batch = PhotonBatch { kind, count: 2_000, pass: 0, seed, max_depth: 8 };
+                trace_photons(&world, batch).iter().map(|p| p.position.to_array()).collect()
+            })
             .collect();
         assert!(maps.iter().all(|m| !m.is_empty()), "{kind:?} stored nothing");
         for a in 0..maps.len() {

@@ -101,12 +101,11 @@ pub fn rel_mse_against(test: &LinearImage, reference: &Reference) -> Result<Erro
 /// What each pixel's error is relative to: the reference, smoothed over
 /// its 3×3 neighbours that lie within its noise. A reference still being
 /// made is noisy, and 1/r² of a noisy r is biased: low draws inflate their
-/// terms, a firefly silences its own (on the Cornell box at equal samples,
-/// relMSE came out 1.2–1.5 times the truth, and the studio had to wait for
-/// four times the pane's samples). A neighbour counts by how many standard
-/// deviations of a difference it lies from the pixel, so a converged
-/// reference (no variance) and an edge keep their own value, and a noisy
-/// flat region its mean.
+/// terms, a firefly silences its own (`tests/references.rs`). A neighbour
+/// counts by how many standard deviations of a difference it lies from the
+/// pixel, so a converged reference (no variance) and an edge keep their own
+/// value, and a noisy flat region its mean; a plain mean would lower every
+/// term along an edge, a median erase thin features.
 fn relative_to(image: &LinearImage, variance: Option<&LinearImage>) -> Vec<[f64; 3]> {
     let own = || image.pixels.iter().map(|p| p.map(f64::from)).collect();
     let Some(variance) = variance else { return own() };

@@ -206,9 +206,7 @@ impl PaneState {
 /// How much noisier than the error it measures a reference still being
 /// made may be: the correction takes the reference's noise off the raw
 /// figure, and where that noise is many times the error left, what is left
-/// is mostly the noise of that correction (on the Cornell box, a pane's
-/// figure stayed within 15% of the truth up to 3 times its error, and
-/// wandered from 0.4 to 1.3 beyond 5).
+/// is mostly the noise of that correction (docs/performance.md, session 31).
 const NOISE_OVER_ERROR: f64 = 3.0;
 
 /// Whether a figure measured against a reference says the pane's error:

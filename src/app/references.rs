@@ -27,10 +27,10 @@ use crate::scene::ValidScene;
 const KEPT_PASSES: u32 = 16;
 
 /// A background reference is young while its own relMSE is above this:
-/// it then takes turns on the threads as all the panes together, since a
-/// reference noisier than a few times a pane's error cannot measure it
-/// (`pane::NOISE_OVER_ERROR`), and panes of the presets reach about this
-/// much in their first half minute.
+/// it then takes turns on the threads as all the panes together twice
+/// over, since a reference noisier than a few times a pane's error cannot
+/// measure it (`pane::NOISE_OVER_ERROR`), and the presets' fastest panes
+/// reach about this much in their first half minute.
 const YOUNG_NOISE: f64 = 2e-3;
 
 /// Where the current reference comes from.

@@ -15,6 +15,7 @@ use super::workers::{Share, Workers};
 use crate::faults::{self, Fault};
 use crate::render::film::Film;
 use crate::render::integrators::bidir::strategies::StrategyImages;
+use crate::render::integrators::path_lanes::PathLanes;
 use crate::render::integrators::photon_map::PhotonMaps;
 use crate::render::integrators::{Integrator, PassObserver, Stage};
 use crate::render::settings::RenderSettings;
@@ -173,7 +174,6 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
     }
     let camera = CameraModel::new(&job.scene.camera, settings.width, settings.height);
     let (world, visible_radius) = World::for_view(&job.scene, &camera, settings.width, settings.height);
-    let stage = Stage { world: &world, camera: &camera, settings };
     // The job's own time: its stages' times on the pool, not the time they
     // waited for other sessions' stages
     let mut busy = Duration::ZERO;
@@ -182,11 +182,15 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
     let halves = settings.algorithm().is_unbiased() || job.reference;
     // The film is made in the job's time: its sums are written as it is
     // made (`Film::new`), which the first pass did before
-    let ((mut film, prepared), took) = workers.run_in_turn(&mut share, || {
+    // The world for eight rays at a time, compiled once for every pass
+    let ((mut film, lanes), took) = workers.run_in_turn(&mut share, || {
         assert!(!faults::active(Fault::RenderPanics), "an injected bug");
-        let film = Film::new(settings.width, settings.height, settings.tile_size, halves);
-        let prepared = Integrator::prepare(&stage, &film, visible_radius, job.photon_maps.clone(), context);
-        (film, prepared)
+        (Film::new(settings.width, settings.height, settings.tile_size, halves), PathLanes::new(&world))
+    });
+    busy += took;
+    let stage = Stage { world: &world, camera: &camera, settings, lanes: lanes.as_ref() };
+    let (prepared, took) = workers.run_in_turn(&mut share, || {
+        Integrator::prepare(&stage, &film, visible_radius, job.photon_maps.clone(), context)
     });
     busy += took;
     let Some(mut integrator) = prepared else {

@@ -74,11 +74,11 @@ pub(crate) fn fly_drawing<T>(
     draws: impl DrawAtHits<T>,
     bounce: impl FnMut(u32, &mut T, Option<&Hit>, Option<&Given>) -> bool,
 ) {
-    let Some(path_lanes) = path_lanes.filter(|_| PathLanes::runs_in_lanes()) else {
+    let Some(path_lanes) = path_lanes else {
         return fly_one_at_a_time(world, indices, launch, ray, bounce);
     };
     #[cfg(target_arch = "x86_64")]
-    // SAFETY: the CPU has AVX2 (`runs_in_lanes`).
+    // SAFETY: the CPU has AVX2: a `PathLanes` is made only where it does.
     #[allow(unsafe_code)]
     return unsafe { fly_avx2(path_lanes, world, indices, launch, ray, draws, bounce) };
     #[cfg(not(target_arch = "x86_64"))]

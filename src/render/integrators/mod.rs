@@ -28,6 +28,7 @@ use crate::render::world::camera::{CameraModel, CameraTile, TileRect};
 use crate::render::world::rng::PassStreams;
 use crate::render::world::World;
 use crate::scene::Rgb;
+use path_lanes::PathLanes;
 use photon_map::maps::resolve_max_radius;
 use photon_map::{PhotonMapStats, PhotonMaps, QueryStats};
 
@@ -114,11 +115,18 @@ pub struct PassReport {
     pub noise: TermSums,
 }
 
+/// Bounces before Russian roulette may end a path (the scalar tracer and
+/// the lanes alike).
+pub(crate) const ROULETTE_DEPTH: u32 = 3;
+
 /// Everything a pass reads: shared, immutable, built once per job.
 pub struct Stage<'a> {
     pub world: &'a World,
     pub camera: &'a CameraModel,
     pub settings: &'a RenderSettings,
+    /// The world compiled for eight rays at a time, where the CPU and the
+    /// world allow: every algorithm traces through it.
+    pub lanes: Option<&'a PathLanes>,
 }
 
 impl Stage<'_> {
@@ -188,13 +196,14 @@ impl Integrator {
     ) -> Option<Self> {
         let settings = stage.settings;
         Some(match &settings.method {
-            Method::Whitted => Integrator::Whitted(whitted::Whitted::new(stage.world, settings.max_depth.max(1))),
-            Method::Path => Integrator::Path(path::PathTracer::new(stage.world, settings.max_depth)),
+            Method::Whitted => Integrator::Whitted(whitted::Whitted::new(settings.max_depth.max(1))),
+            Method::Path => Integrator::Path(path::PathTracer::new(settings.max_depth)),
             Method::Photon(photon) => {
                 let maps = match maps {
                     Some(maps) => maps,
                     None => Arc::new(PhotonMaps::build_until(
                         stage.world,
+                        stage.lanes,
                         photon,
                         settings.seed,
                         settings.max_depth,
@@ -202,15 +211,9 @@ impl Integrator {
                     )?),
                 };
                 let max_radius = resolve_max_radius(visible_radius, photon);
-                Integrator::Photon(photon::PhotonMapping::new(
-                    stage.world,
-                    maps,
-                    photon,
-                    settings.max_depth,
-                    max_radius,
-                ))
+                Integrator::Photon(photon::PhotonMapping::new(maps, photon, settings.max_depth, max_radius))
             }
-            Method::Sppm(sppm) => Integrator::Sppm(sppm::Sppm::new(stage.world, film, sppm, settings, visible_radius)),
+            Method::Sppm(sppm) => Integrator::Sppm(sppm::Sppm::new(film, sppm, settings, visible_radius)),
             Method::LightTracing | Method::Bdpt(_) | Method::Bpm(_) | Method::Vcm(_) => {
                 Integrator::Bidir(bidir::Bidir::new(stage.world, settings, visible_radius))
             }

@@ -3,9 +3,8 @@
 //! sampling for area lights, Russian roulette.
 
 use super::next_event::PathScope;
-use super::path_lanes::PathLanes;
-use super::Counters;
 use super::Stage;
+use super::{Counters, ROULETTE_DEPTH};
 use crate::faults::{self, Fault};
 use crate::geometry::Ray;
 use crate::render::world::bsdf::{Bsdf, Transport};
@@ -15,21 +14,15 @@ use crate::render::world::sampling::{power_heuristic, uniform_sphere_pdf};
 use crate::render::world::World;
 use crate::scene::Rgb;
 
-/// Bounces before Russian roulette may end a path.
-pub(crate) const ROULETTE_DEPTH: u32 = 3;
-
 /// Path tracing: eight paths at a time where the lanes can trace the world
-/// (`PathLanes`: spheres, planes, triangles, Lambert, mirror and glass; the
-/// same samples bit for bit), one at a time elsewhere.
+/// (`Stage::lanes`; the same samples bit for bit), one at a time elsewhere.
 pub struct PathTracer {
     max_depth: u32,
-    /// Boxed: it holds the scene's shapes and lights, the tracer is moved about.
-    lanes: Option<Box<PathLanes>>,
 }
 
 impl PathTracer {
-    pub fn new(world: &World, max_depth: u32) -> Self {
-        Self { max_depth, lanes: PathLanes::new(world).map(Box::new) }
+    pub fn new(max_depth: u32) -> Self {
+        Self { max_depth }
     }
 
     #[inline]
@@ -46,7 +39,7 @@ impl PathTracer {
         out: &mut impl FnMut(usize, Rgb),
         counters: &mut Counters,
     ) {
-        if let Some(lanes) = &self.lanes {
+        if let Some(lanes) = stage.lanes {
             return lanes.radiance(stage.world, tile, self.max_depth, out, counters);
         }
         for i in 0..tile.len() {
@@ -124,4 +117,49 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
         ray = hit.surface.spawn_ray(scattered.wi);
     }
     radiance
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::integrators::path_lanes::PathLanes;
+    use crate::render::settings::RenderSettings;
+    use crate::render::world::camera::{CameraModel, TileRect};
+    use crate::render::world::rng::PassStreams;
+
+    /// A tile rendered through the lanes and one at a time (what a CPU
+    /// without AVX2 renders): the same samples bit for bit, each handed out
+    /// once (`tests/path_lanes.rs` holds the lanes to the scalar tracer at
+    /// length).
+    #[test]
+    fn a_tile_in_lanes_is_the_tile_one_at_a_time() {
+        let scene = crate::scene::presets::preset("smallpt").and_then(Result::ok).expect("smallpt preset");
+        let camera = CameraModel::new(&scene.camera, 24, 18);
+        let (world, _) = World::for_view(&scene, &camera, 24, 18);
+        let rect = TileRect { x: 0, y: 0, width: 24, height: 18 };
+        let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(0, 3) };
+        let lanes = PathLanes::new(&world).expect("spheres only, on a CPU with AVX2");
+        let settings = RenderSettings::default();
+        let tracer = PathTracer::new(32);
+        let mut rendered = Vec::new();
+        for lanes in [Some(&lanes), None] {
+            let stage = Stage { world: &world, camera: &camera, settings: &settings, lanes };
+            let (mut got, mut handed_out, mut counters) =
+                (vec![Rgb::ZERO; tile.len()], vec![0; tile.len()], Counters::default());
+            tracer.render_tile(
+                &stage,
+                &tile,
+                &mut |i, v| {
+                    got[i] = v;
+                    handed_out[i] += 1;
+                },
+                &mut counters,
+            );
+            assert!(handed_out.iter().all(|&n| n == 1), "each sample handed out once: {handed_out:?}");
+            rendered.push((got.iter().map(|c| c.to_array().map(f32::to_bits)).collect::<Vec<_>>(), counters.rays));
+        }
+        assert_eq!(rendered[0], rendered[1]);
+        let lit = rendered[1].0.iter().filter(|v| v.iter().any(|&c| f32::from_bits(c) > 0.0)).count();
+        assert!(lit > 200, "samples carried light");
+    }
 }

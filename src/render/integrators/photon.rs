@@ -9,7 +9,6 @@ use glam::Vec3;
 
 use super::next_event::lit_sum;
 use super::next_event::PathScope;
-use super::path_lanes::PathLanes;
 use super::photon_map::kdtree::Neighbours;
 use super::photon_map::maps::{estimate, PhotonMaps, QueryStats};
 use super::shadow_batch::ShadowBatch;
@@ -45,21 +44,11 @@ pub struct PhotonMapping {
     max_radius: f32,
     settings: PhotonSettings,
     max_depth: u32,
-    /// The world for eight rays at a time, where it can be compiled: the
-    /// camera rays and the shadow rays of their landings.
-    lanes: Option<Box<PathLanes>>,
 }
 
 impl PhotonMapping {
-    pub fn new(
-        world: &World,
-        maps: Arc<PhotonMaps>,
-        settings: &PhotonSettings,
-        max_depth: u32,
-        max_radius: f32,
-    ) -> Self {
-        let lanes = PathLanes::new(world).map(Box::new);
-        Self { maps, max_radius, settings: settings.clone(), max_depth, lanes }
+    pub fn new(maps: Arc<PhotonMaps>, settings: &PhotonSettings, max_depth: u32, max_radius: f32) -> Self {
+        Self { maps, max_radius, settings: settings.clone(), max_depth }
     }
 
     pub fn scratch(&self) -> PhotonScratch {
@@ -88,7 +77,7 @@ impl PhotonMapping {
         out: &mut impl FnMut(usize, Rgb),
         counters: &mut Counters,
     ) {
-        let (world, lanes) = (stage.world, self.lanes.as_deref());
+        let (world, lanes) = (stage.world, stage.lanes);
         let mut scratch = self.scratch();
         let (mut shadows, mut terms) = (ShadowBatch::default(), Vec::new());
         // Each sample's light on the way, and at its landing the throughput,
@@ -277,6 +266,7 @@ impl PhotonRenderer<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::integrators::path_lanes::PathLanes;
     use crate::render::integrators::photon_map::maps::resolve_max_radius;
     use crate::render::settings::RenderSettings;
     use crate::render::world::camera::{CameraModel, TileRect};
@@ -303,9 +293,10 @@ mod tests {
                     final_gather_rays: 3,
                     ..PhotonSettings::default()
                 };
-                let maps = PhotonMaps::build_until(&world, &settings, 3, 8, &|| true).expect("maps");
+                let compiled = PathLanes::new(&world);
+                let maps = PhotonMaps::build_until(&world, compiled.as_ref(), &settings, 3, 8, &|| true).expect("maps");
                 let max_radius = resolve_max_radius(visible_radius, &settings);
-                let photon = PhotonMapping::new(&world, Arc::new(maps), &settings, 8, max_radius);
+                let photon = PhotonMapping::new(Arc::new(maps), &settings, 8, max_radius);
                 let rect = TileRect { x: 3, y: 2, width: 21, height: 9 };
                 let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(2, 9) };
                 let (mut expected_counters, mut scratch) = (Counters::default(), photon.scratch());
@@ -318,15 +309,11 @@ mod tests {
                     .collect();
                 expected_counters.queries.add(&scratch.queries);
                 let settings = RenderSettings::default();
-                let stage = Stage { world: &world, camera: &camera, settings: &settings };
                 for lanes in [true, false] {
-                    let scalar = PhotonMapping {
-                        lanes: None,
-                        ..PhotonMapping::new(&world, photon.maps.clone(), &photon.settings, 8, max_radius)
-                    };
-                    let renderer = if lanes { &photon } else { &scalar };
+                    let lanes_if = compiled.as_ref().filter(|_| lanes);
+                    let stage = Stage { world: &world, camera: &camera, settings: &settings, lanes: lanes_if };
                     let (mut out, mut counters) = (vec![Rgb::splat(-1.0); tile.len()], Counters::default());
-                    renderer.render_tile(&stage, &tile, &mut |i, v| out[i] = v, &mut counters);
+                    photon.render_tile(&stage, &tile, &mut |i, v| out[i] = v, &mut counters);
                     let got: Vec<[u32; 3]> = out.iter().map(|v| v.to_array().map(f32::to_bits)).collect();
                     let what = format!("{name}, final gather {final_gather}, lanes {lanes}");
                     assert!(got == expected, "{what}: the light differs");

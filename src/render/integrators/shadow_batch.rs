@@ -40,7 +40,7 @@ impl ShadowBatch {
         self.blocked.clear();
         self.blocked.resize(self.shadows.len(), false);
         match lanes {
-            Some(lanes) => lanes.shadows_blocked(world, &self.shadows, &mut self.blocked),
+            Some(lanes) => lanes.shadows_blocked(&self.shadows, &mut self.blocked),
             None => (self.shadows.iter().zip(&mut self.blocked)).for_each(|(shadow, out)| *out = world.blocked(shadow)),
         }
     }

@@ -16,7 +16,7 @@ use super::next_event::lit_sum;
 use super::next_event::PathScope;
 use super::path_lanes::PathLanes;
 use super::photon_map::grid::PhotonGrid;
-use super::photon_map::trace::{trace_photons_until, MapKind};
+use super::photon_map::trace::{trace_photons_until, MapKind, PhotonBatch};
 use super::photon_map::Photon;
 use super::shadow_batch::ShadowBatch;
 use super::specular::{follow_specular, follow_specular_tile, Emission, Landing};
@@ -40,22 +40,13 @@ pub struct Sppm {
     alpha: f32,
     max_depth: u32,
     seed: u64,
-    /// The world for eight rays at a time, where it can be compiled: the
-    /// eye pass's rays and shadow rays.
-    lanes: Option<Box<PathLanes>>,
     /// The last pass's photons: each pass traces into their memory.
     photons: Vec<Photon>,
 }
 
 impl Sppm {
     /// The starting radius is the settings', or 2% of what the camera sees.
-    pub fn new(
-        world: &World,
-        film: &Film,
-        sppm: &SppmSettings,
-        settings: &RenderSettings,
-        visible_radius: f32,
-    ) -> Self {
+    pub fn new(film: &Film, sppm: &SppmSettings, settings: &RenderSettings, visible_radius: f32) -> Self {
         let initial_radius =
             if sppm.initial_radius > 0.0 { sppm.initial_radius } else { (visible_radius * 0.02).max(1e-6) };
         Self {
@@ -65,7 +56,6 @@ impl Sppm {
             alpha: sppm.alpha,
             max_depth: settings.max_depth,
             seed: settings.seed,
-            lanes: PathLanes::new(world).map(Box::new),
             photons: Vec::new(),
         }
     }
@@ -92,7 +82,7 @@ impl Sppm {
     ) -> Option<PassReport> {
         let streams = stage.streams(pass as u64);
         let initial_radius = self.initial_radius;
-        let (max_depth, lanes) = (self.max_depth, self.lanes.as_deref());
+        let (max_depth, lanes) = (self.max_depth, stage.lanes);
         let mut report = PassReport::default();
         let eye_start = Instant::now();
         let per_tile: Vec<Counters> = (film.tiles.par_iter())
@@ -126,9 +116,9 @@ impl Sppm {
         let trace_start = Instant::now();
         let count = self.photons_per_pass;
         let keep_going = || observer.is_current();
-        let (world, seed) = (stage.world, self.seed);
+        let batch = PhotonBatch { kind: MapKind::Indirect, count, pass: pass as u64, seed: self.seed, max_depth };
         let photons = &mut self.photons;
-        trace_photons_until(world, MapKind::Indirect, count, pass as u64, seed, max_depth, &keep_going, photons)?;
+        trace_photons_until(stage.world, stage.lanes, batch, &keep_going, photons)?;
         times.trace = trace_start.elapsed();
         report.photon.photons_traced = count;
         report.photon.photons_stored = photons.len() as u64;

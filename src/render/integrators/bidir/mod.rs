@@ -74,9 +74,6 @@ pub struct Bidir {
     picker: LightPicker,
     /// What each strategy brought so far, while the view asks for it.
     strategy_film: Option<StrategyFilm>,
-    /// The world compiled for eight rays at a time, for the light subpaths'
-    /// flights and every shadow ray.
-    path_lanes: Option<Box<PathLanes>>,
     /// The merge grid's records, from pass to pass.
     merge_buffers: MergeBuffers,
 }
@@ -144,7 +141,6 @@ impl Bidir {
             seed: settings.seed,
             picker: LightPicker::new(world),
             strategy_film: None,
-            path_lanes: PathLanes::new(world).map(Box::new),
             merge_buffers: MergeBuffers::default(),
         }
     }
@@ -194,7 +190,7 @@ impl Bidir {
         let background = world.lights.iter().position(|l| matches!(l, LightSource::Background { .. }));
         let ctx = Context {
             world,
-            path_lanes: self.path_lanes.as_deref(),
+            path_lanes: stage.lanes,
             camera: stage.camera,
             strategies: weighing,
             picker: &self.picker,

@@ -31,7 +31,7 @@ pub(crate) use scatter::{LaneSurfaces, Scattered};
 use surface_table::SurfaceTable;
 use wall_exits::WallExits;
 
-use super::Counters;
+use super::{Counters, ROULETTE_DEPTH};
 use crate::faults::{self, Fault};
 use crate::geometry::sphere::{nearest_root, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_finish_of, watertight_range_of, RayShear};
@@ -45,9 +45,6 @@ use crate::render::world::occluders::Shadow;
 use crate::render::world::sampling::{power_heuristic, power_heuristic_of, uniform_sphere_pdf};
 use crate::render::world::{Hit, ShapeRef, World};
 use crate::scene::{MaterialModel, Rgb};
-
-/// Bounces before Russian roulette may end a path (as in `path`).
-const ROULETTE_DEPTH: u32 = crate::render::integrators::path::ROULETTE_DEPTH;
 
 /// The `Bsdf` each shape's lanes run, as a float to compare eight at a
 /// time.
@@ -187,9 +184,13 @@ pub struct PathLanes {
 }
 
 impl PathLanes {
-    /// For worlds of spheres, planes and triangles (`None` for a world
-    /// of none).
+    /// For worlds of spheres, planes and triangles on a CPU that runs the
+    /// lanes (`None` for a world of none, or a CPU without AVX2).
     pub fn new(world: &World) -> Option<Self> {
+        // Its methods run AVX2 without asking again
+        if !lanes::supported() {
+            return None;
+        }
         let surface = |object: u32| {
             let material = &world.materials[world.objects[object as usize].material as usize];
             let plain = |kind, color, ior| Surface {
@@ -378,11 +379,8 @@ impl PathLanes {
         out: &mut impl FnMut(usize, Rgb),
         counters: &mut Counters,
     ) {
-        if !lanes::supported() {
-            return one_by_one(world, tile, max_depth, out, counters);
-        }
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the CPU has AVX2 (`lanes::supported`).
+        // SAFETY: the CPU has AVX2: a `PathLanes` is made only where it does.
         #[allow(unsafe_code)]
         unsafe {
             self.radiance_avx2(world, tile, max_depth, out, counters)
@@ -894,12 +892,9 @@ impl PathLanes {
     /// Which of `shadows` something blocks (`blocked[i]` says of
     /// `shadows[i]`): `World::blocked` of each, bit for bit, eight at a time
     /// where the CPU has AVX2.
-    pub fn shadows_blocked(&self, world: &World, shadows: &[Shadow], blocked: &mut [bool]) {
-        if !lanes::supported() {
-            return shadows.iter().zip(blocked).for_each(|(shadow, out)| *out = world.blocked(shadow));
-        }
+    pub fn shadows_blocked(&self, shadows: &[Shadow], blocked: &mut [bool]) {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the CPU has AVX2 (`lanes::supported`).
+        // SAFETY: the CPU has AVX2: a `PathLanes` is made only where it does.
         #[allow(unsafe_code)]
         unsafe {
             self.shadows_blocked_avx2(shadows, blocked)
@@ -1032,20 +1027,6 @@ fn lane_culls(triangles: &[(Triangle, u32)]) -> Vec<LaneCull> {
         .collect()
 }
 
-/// Without lanes (a CPU without AVX2): the scalar tracer, sample by sample.
-fn one_by_one(
-    world: &World,
-    tile: &CameraTile,
-    max_depth: u32,
-    out: &mut impl FnMut(usize, Rgb),
-    counters: &mut Counters,
-) {
-    for i in 0..tile.len() {
-        let (ray, mut sampler) = tile.sample(i);
-        out(i, crate::render::integrators::path::radiance(world, &ray, max_depth, &mut sampler, counters));
-    }
-}
-
 /// Eight paths in flight.
 struct Lanes {
     active: M8,
@@ -1138,35 +1119,6 @@ impl Lanes {
 mod tests {
     use super::*;
     use crate::geometry::shear_of;
-    use crate::render::world::camera::{CameraModel, TileRect};
-    use crate::render::world::rng::PassStreams;
-
-    /// What a CPU without AVX2 renders: the scalar tracer's samples, the
-    /// lanes' bit for bit (`tests/path_lanes.rs` holds the lanes to the
-    /// scalar tracer at length).
-    #[test]
-    fn without_lanes_the_samples_are_the_same() {
-        let scene = crate::scene::presets::preset("smallpt").and_then(Result::ok).expect("smallpt preset");
-        let camera = CameraModel::new(&scene.camera, 24, 18);
-        let (world, _) = World::for_view(&scene, &camera, 24, 18);
-        let rect = TileRect { x: 0, y: 0, width: 24, height: 18 };
-        let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(0, 3) };
-        let lanes = PathLanes::new(&world).expect("spheres only");
-        let (mut got, mut expected) = (vec![Rgb::splat(-1.0); tile.len()], vec![Rgb::splat(-2.0); tile.len()]);
-        let (mut lane_counters, mut scalar_counters) = (Counters::default(), Counters::default());
-        let mut handed_out = vec![0; tile.len()];
-        let mut sink = |i: usize, v| {
-            got[i] = v;
-            handed_out[i] += 1;
-        };
-        lanes.radiance(&world, &tile, 32, &mut sink, &mut lane_counters);
-        assert!(handed_out.iter().all(|&n| n == 1), "each sample handed out once: {handed_out:?}");
-        one_by_one(&world, &tile, 32, &mut |i, v| expected[i] = v, &mut scalar_counters);
-        let bits = |v: &[Rgb]| v.iter().map(|c| c.to_array().map(f32::to_bits)).collect::<Vec<_>>();
-        assert_eq!(bits(&got), bits(&expected));
-        assert_eq!(lane_counters.rays, scalar_counters.rays);
-        assert!(expected.iter().filter(|v| v.max_element() > 0.0).count() > 200, "samples carried light");
-    }
 
     /// The lanes' triangle test (the crossing where the cull is sure, the
     /// watertight test in the other lanes it lets through) is

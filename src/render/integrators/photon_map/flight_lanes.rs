@@ -49,11 +49,10 @@ impl PhotonLanes {
 
 impl Tracing<'_> {
     /// Photons `indices` through `path_lanes`, each stored photon told to
-    /// `store` with its photon's place in `indices`. Only on a CPU the
-    /// lanes run on (`PathLanes::runs_in_lanes`).
+    /// `store` with its photon's place in `indices`.
     pub(super) fn fly_in_lanes(&self, path_lanes: &PathLanes, indices: Range<u64>, store: impl FnMut(u32, Photon)) {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the caller checked that the CPU has AVX2.
+        // SAFETY: the CPU has AVX2: a `PathLanes` is made only where it does.
         #[allow(unsafe_code)]
         unsafe {
             self.fly_avx2(path_lanes, indices, store)

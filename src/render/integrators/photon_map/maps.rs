@@ -5,8 +5,9 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 
+use crate::render::integrators::path_lanes::PathLanes;
 use crate::render::integrators::photon_map::kdtree::{Neighbours, PhotonKdTree};
-use crate::render::integrators::photon_map::trace::{trace_photons_until, MapKind};
+use crate::render::integrators::photon_map::trace::{trace_photons_until, MapKind, PhotonBatch};
 use crate::render::world::bsdf::Bsdf;
 use crate::render::world::World;
 use crate::render::PhotonSettings;
@@ -80,16 +81,19 @@ pub fn resolve_max_radius(visible_radius: f32, settings: &PhotonSettings) -> f32
 }
 
 impl PhotonMaps {
-    /// Trace both maps.
+    /// Trace both maps, with `seed` and paths of at most `max_depth`.
     pub fn build(world: &World, settings: &PhotonSettings, seed: u64, max_depth: u32) -> Self {
-        let built = Self::build_until(world, settings, seed, max_depth, &|| true);
+        let lanes = PathLanes::new(world);
+        let built = Self::build_until(world, lanes.as_ref(), settings, seed, max_depth, &|| true);
         built.expect("a build that is never abandoned")
     }
 
-    /// `build`, asking `keep_going` before each chunk of photons (see
-    /// `trace_photons_until`) and before each tree: None once it says no.
+    /// `build` through `lanes` where given, asking `keep_going` before each
+    /// chunk of photons (see `trace_photons_until`) and before each tree:
+    /// None once it says no.
     pub fn build_until(
         world: &World,
+        lanes: Option<&PathLanes>,
         settings: &PhotonSettings,
         seed: u64,
         max_depth: u32,
@@ -98,7 +102,8 @@ impl PhotonMaps {
         let build = |kind: MapKind, count: u32| -> Option<(PhotonKdTree, MapStats)> {
             let start = Instant::now();
             let mut photons = Vec::new();
-            trace_photons_until(world, kind, count as u64, 0, seed, max_depth, keep_going, &mut photons)?;
+            let batch = PhotonBatch { kind, count: count as u64, pass: 0, seed, max_depth };
+            trace_photons_until(world, lanes, batch, keep_going, &mut photons)?;
             let trace_time = start.elapsed();
             if !keep_going() {
                 return None;

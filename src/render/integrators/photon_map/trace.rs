@@ -21,10 +21,22 @@ use crate::render::world::{Hit, World};
 /// Photons a task traces: the unit of work a cancel waits for at most.
 pub const CHUNK: u64 = 4096;
 
-/// Trace `count` photons for `kind`; stored powers are divided by `count`.
-pub fn trace_photons(world: &World, kind: MapKind, count: u64, pass: u64, seed: u64, max_depth: u32) -> Vec<Photon> {
-    let mut photons = Vec::new();
-    trace_photons_until(world, kind, count, pass, seed, max_depth, &|| true, &mut photons);
+/// Which photons to trace: for which map, how many (stored powers are
+/// divided by the count), the pass and seed that fix their random streams,
+/// and the longest path.
+#[derive(Clone, Copy, Debug)]
+pub struct PhotonBatch {
+    pub kind: MapKind,
+    pub count: u64,
+    pub pass: u64,
+    pub seed: u64,
+    pub max_depth: u32,
+}
+
+/// Trace `batch` through `world` (eight at a time where the lanes run).
+pub fn trace_photons(world: &World, batch: PhotonBatch) -> Vec<Photon> {
+    let (lanes, mut photons) = (PathLanes::new(world), Vec::new());
+    trace_photons_until(world, lanes.as_ref(), batch, &|| true, &mut photons);
     photons
 }
 
@@ -34,23 +46,19 @@ pub fn trace_photons(world: &World, kind: MapKind, count: u64, pass: u64, seed: 
 /// memory from call to call: SPPM traces each pass into the last pass's
 /// array, whose pages are then there already (a million photons' array,
 /// 70 MB, is beyond what the heap keeps, `engine::keep_freed_memory`).
-#[allow(clippy::too_many_arguments)]
+/// Eight at a time through `lanes` where given.
 pub fn trace_photons_until(
     world: &World,
-    kind: MapKind,
-    count: u64,
-    pass: u64,
-    seed: u64,
-    max_depth: u32,
+    lanes: Option<&PathLanes>,
+    batch: PhotonBatch,
     keep_going: &(dyn Fn() -> bool + Sync),
     photons: &mut Vec<Photon>,
 ) -> Option<()> {
     photons.clear();
+    let PhotonBatch { kind, count, pass, seed, max_depth } = batch;
     let Some(tracing) = Tracing::new(world, kind, count, pass, seed, max_depth) else {
         return Some(());
     };
-    // Built once for all the chunks: None where the world has no lanes
-    let lanes = PathLanes::new(world);
     // usize: rayon splits only ranges of usize by index
     let chunks = count.div_ceil(CHUNK) as usize;
     let per_chunk: Option<Vec<Vec<Photon>>> = (0..chunks)
@@ -62,7 +70,7 @@ pub fn trace_photons_until(
             }
             let chunk = chunk as u64;
             let indices = chunk * CHUNK..((chunk + 1) * CHUNK).min(count);
-            Some(trace_chunk(lanes.as_ref(), &tracing, indices))
+            Some(trace_chunk(lanes, &tracing, indices))
         })
         .collect();
     let per_chunk = per_chunk?;
@@ -74,13 +82,13 @@ pub fn trace_photons_until(
 }
 
 /// The photons `indices`: what they store, in photon order. Eight at a
-/// time through `path_lanes` where given (and the CPU allows), with the
-/// same records bit for bit.
+/// time through `path_lanes` where given, with the same records bit for
+/// bit.
 fn trace_chunk(path_lanes: Option<&PathLanes>, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
     // Each stored photon, and its photon's place among `indices`
     let (mut stored, mut places) = (Vec::new(), Vec::new());
     let items = (indices.end - indices.start) as usize;
-    match path_lanes.filter(|_| PathLanes::runs_in_lanes()) {
+    match path_lanes {
         Some(path_lanes) => tracing.fly_in_lanes(path_lanes, indices, |place, photon| {
             stored.push(photon);
             places.push(place);

@@ -14,7 +14,6 @@ mod shading;
 mod waves;
 
 use super::next_event::PathScope;
-use super::path_lanes::PathLanes;
 use super::Stage;
 use crate::geometry::Ray;
 use crate::render::integrators::Counters;
@@ -28,13 +27,11 @@ use shading::{branches, combine, light_term, lit_cosine, shades};
 /// Whitted ray tracing, recursing at most `max_depth` times.
 pub struct Whitted {
     pub max_depth: u32,
-    /// The world for eight rays at a time, where it can be compiled.
-    lanes: Option<Box<PathLanes>>,
 }
 
 impl Whitted {
-    pub fn new(world: &World, max_depth: u32) -> Self {
-        Self { max_depth, lanes: PathLanes::new(world).map(Box::new) }
+    pub fn new(max_depth: u32) -> Self {
+        Self { max_depth }
     }
 
     #[inline]
@@ -52,7 +49,7 @@ impl Whitted {
         counters: &mut Counters,
     ) {
         let mut values = vec![Rgb::ZERO; tile.len()];
-        waves::render_tile(stage.world, self.lanes.as_deref(), tile, self.max_depth, &mut values, counters);
+        waves::render_tile(stage.world, stage.lanes, tile, self.max_depth, &mut values, counters);
         values.into_iter().enumerate().for_each(|(i, value)| out(i, value));
     }
 }
