@@ -7,9 +7,8 @@ use eframe::egui;
 
 /// How soon a pass's progress from the engine is drawn: often enough to
 /// look live, seldom enough that drawing leaves the cores to the renders.
-/// Under Xvfb's software GL on two cores, a frame of four panes costs most
-/// of a core to present: at 5 frames a second the four panes rendered 1.8×
-/// the passes they rendered at 20 in the same time.
+/// Under software GL a frame of four panes costs most of a core to
+/// present, which a faster rate takes from the renders.
 pub const RENDER_REPAINT: std::time::Duration = std::time::Duration::from_millis(200);
 
 /// Ask for a frame for the engine's news (at once) or progress (soon).

@@ -74,9 +74,9 @@ pub struct Run {
 }
 
 /// Images kept for FLIP until the render ends, at most this many bytes:
-/// FLIP measured between passes took the CPU from the render it timed (its
-/// thread runs above the workers), 5–10% of a pass early on, where the
-/// table's times to an error are read. Past the bound (huge images over a
+/// FLIP measured between passes would take the CPU from the render it
+/// times (its thread runs above the workers), most of all early on, where
+/// the table's times to an error are read. Past the bound (huge images over a
 /// long budget) FLIP is measured at once again.
 const FLIP_KEPT_BYTES: usize = 256 << 20;
 

@@ -16,10 +16,8 @@
 //! shadow ray there is blocked without it, and a ray looking for its
 //! nearest hit takes the crossing, put back onto the plane, as its hit
 //! (`CullPlane::hit_point`). Only rays near an edge pay for the watertight
-//! test (gap-room's path tracing, 128×96, 8 spp: 205.8 M → 201.6 M
-//! instructions, 0.96 of the time). Nor do rays leaving the plane, those
-//! spawned off its triangles above all, whose crossing lies just behind
-//! them (`leaving`: 201.6 M → 192.7 M, 0.93 of the time).
+//! test. Nor do rays leaving the plane, those spawned off its triangles
+//! above all, whose crossing lies just behind them (`leaving`).
 //!
 //! One case it decides differently: a triangle seen from more than about
 //! a thousand times its size, whose watertight edge functions (products

@@ -106,8 +106,7 @@ pub(crate) fn takes_fast_path(x_bits: u32, y_bits: u32) -> bool {
 /// subnormal: a subnormal costs x86 a microcode assist of a hundred cycles
 /// or more where it is made and again wherever it is used, and such powers
 /// (the far tails of glossy lobes, cosⁿ for n in the hundreds) carry
-/// nothing an image can hold. Flushed, the glossy preset's path tracing
-/// takes 0.96 of the time.
+/// nothing an image can hold.
 #[inline]
 pub fn powf(x: f32, y: f32) -> f32 {
     if !takes_fast_path(x.to_bits(), y.to_bits()) {

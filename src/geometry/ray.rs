@@ -38,8 +38,7 @@ pub const fn gamma(n: u32) -> f32 {
 /// numbers a ray meets, would be subnormal, and each subnormal operand or
 /// result costs x86 a microcode assist of a hundred cycles or more. The
 /// lanes of paths that have ended sit at the origin and still spawn shadow
-/// rays, eight lanes at a time: glossy.ron, where most paths leave the
-/// scene, spent a quarter of its time in those assists.
+/// rays, eight lanes at a time, most of all where paths leave the scene.
 #[inline(always)]
 pub fn spawn_offset_scale<R: Real>(p: V3<R>) -> R {
     const ULPS: f32 = 256.0;

@@ -59,9 +59,9 @@ pub fn nearest_root<R: Real>(f: V3<R>, direction: V3<R>, radius2: R, t_max: R) -
 /// of radius 1e5 (smallpt's) puts every |o − c|² − r² of a ray from the
 /// room at a difference of two numbers near 1e10, good in f32 only to
 /// about 1e3: its hits come out 0.01–0.07 off, the offsets that keep the
-/// next ray off the wall grow to match (smallpt renders 0.5% too bright
-/// from that alone), and where two walls meet a path may take the farther
-/// hit and leave the room. About the anchor the same quantity is
+/// next ray off the wall grow to match (smallpt renders too bright from
+/// that alone), and where two walls meet a path may take the farther hit
+/// and leave the room. About the anchor the same quantity is
 /// |e|² + 2r(e · n), e = o − anchor, each term good to its own few ulps.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AnchoredSphere {

@@ -92,8 +92,7 @@ impl TermSums {
 /// memory (`vec![0.0; n]`, calloc), which leaves fresh pages unmapped: a
 /// pass would first read each as the shared zero page, and its write after
 /// that copies the page and stops the other render threads to flush their
-/// view of it (a TLB shootdown, slow in a VM), page by page. At 512×384 on two
-/// threads, the first two passes took 24 ms each instead of 13.
+/// view of it (a TLB shootdown, slow in a VM), page by page.
 fn written_zeros(n: usize) -> Vec<[f64; 3]> {
     let mut sums = Vec::with_capacity(n);
     sums.resize(n, [0.0; 3]);
@@ -347,8 +346,7 @@ mod tests {
     /// A new tile's sums are in memory, written: pages the allocator hands
     /// over unwritten (calloc's, `vec![0.0; n]`) would be read first by the
     /// first pass as the shared zero page, and the write after that stops
-    /// the other render threads to flush it, page by page (20 ms of a
-    /// 512×384 render's first two passes at two threads). Sums of 50 MB, so
+    /// the other render threads to flush it, page by page. Sums of 50 MB, so
     /// that glibc maps fresh pages for them however its threshold has moved.
     #[cfg(target_os = "linux")]
     #[test]

@@ -3,8 +3,7 @@
 //! and frees them at its end; glibc hands such memory back to the kernel
 //! (an `mmap` per buffer above 128 KiB at first, and a thread's heap
 //! trimmed once 128 KiB lie free at its top), so the next pass faults every
-//! page in again, zeroed by the kernel. On SPPM's cornell at 256×192 that
-//! was 0.36 s of system time in 2.6 s of CPU.
+//! page in again, zeroed by the kernel, in system time every pass.
 
 /// The largest `M_MMAP_THRESHOLD` glibc takes on 64-bit (half its 64 MiB
 /// thread heaps): buffers up to this size come from the heaps.

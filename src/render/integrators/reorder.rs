@@ -20,8 +20,8 @@ pub fn by_item<T: Copy>(records: &[T], places: &[u32], items: usize) -> (Vec<T>,
 /// `0..key_count`: `order` lists the items by key, each key's in their own
 /// order, and key k's are `order[starts[k]..starts[k + 1]]`. Large sorts
 /// run on up to `BLOCKS` threads, each counting and placing its own block
-/// of the items: the same result, which no thread count changes (SPPM's
-/// 2.5 M photons took 60 ms a pass on one thread, a third of its grid's time).
+/// of the items: the same result, which no thread count changes (SPPM
+/// sorts millions of photons a pass).
 pub fn by_key(keys: &[u32], key_count: usize) -> (Vec<u32>, Vec<u32>) {
     let blocks = rayon::current_num_threads().min(BLOCKS).min(keys.len() / PARALLEL_FROM);
     if blocks < 2 {

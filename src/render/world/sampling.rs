@@ -10,7 +10,7 @@ use crate::geometry::real::{Mask, Real, V3};
 pub(crate) const ROUND_BY_ADDING: f32 = 12_582_912.0;
 
 /// sin x and cos x together, inline: the warps below call them once per
-/// sample, and libm's out-of-line `sincosf` was 5% of path tracing. Reduced
+/// sample, and libm's `sincosf` is out of line (a call per sample). Reduced
 /// to |r| ≤ π/4 by quadrant (π/2 split in three, Cody–Waite, so r stays exact
 /// for the |x| ≤ 2π the warps pass), then cephes' minimax polynomials: within
 /// 2·10⁻⁷ of the true values.

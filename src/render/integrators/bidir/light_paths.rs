@@ -70,8 +70,8 @@ impl LightVertex {
 /// One pass's light subpaths.
 pub struct LightPaths {
     /// The vertices, `CHUNK` paths a chunk as they were traced: joined
-    /// into one array, a pass's hundred MB were copied and their pages
-    /// faulted in afresh (7% of BDPT on gap-room at 512×384, under `perf`).
+    /// into one array, a pass's hundred MB would be copied and their pages
+    /// faulted in afresh.
     pub chunks: Vec<PathChunk>,
     /// Joins to the camera, by chunk in the order of the paths.
     pub splats: Vec<Vec<Splat>>,
@@ -355,8 +355,7 @@ impl<'w> Flights<'_, 'w> {
         // Which path made each vertex, splat and contribution: its place among `indices`
         let mut places = Vec::new();
         if self.ctx.keeps_vertices() {
-            // Room for most chunks' vertices at once: grown from nothing,
-            // their copies were 2% of a VCM render's instructions
+            // Room for most chunks' vertices at once, not grown from nothing
             let expected = (indices.end - indices.start) as usize * EXPECTED_VERTICES;
             (out.vertices, places) = (Vec::with_capacity(expected), Vec::with_capacity(expected));
         }

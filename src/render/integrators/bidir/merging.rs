@@ -1,9 +1,8 @@
 //! The light vertices as merges find them: a hash grid of their positions
 //! (`cells::PointGrid`) and, in the grid's order, what a merge reads of
 //! each. A query's candidates then lie in sequence; read from the vertices
-//! themselves, each was a cache miss, and most candidates are turned away
-//! (on gap-room half lie behind the wall the camera vertex is on): under
-//! `perf` those misses were a fifth of a BPM render.
+//! themselves, each would be a cache miss, and most candidates are turned
+//! away (behind the wall the camera vertex is on, say).
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -14,9 +13,8 @@ use crate::render::integrators::photon_map::cells::PointGrid;
 use crate::scene::Rgb;
 
 /// The grid's cells, in merge radii. A query touches 1 to 8 cells and
-/// finds a light vertex or two among a few dozen; measured on gap-room
-/// (VCM, 256×192, 16 passes, against the kd-tree): 2 radii 0.95 of the
-/// kd-tree's time, 4 radii 0.87–0.89, 8 radii 0.87–0.90, 1 radius 1.18.
+/// finds a light vertex or two among a few dozen: smaller cells cost more
+/// cells a query, larger ones more candidates (docs/performance.md).
 const MERGE_CELLS: f32 = 4.0;
 
 /// What a merge reads of a light vertex.
@@ -41,11 +39,10 @@ pub struct MergeGrid {
     spare: (Vec<MergeVertex>, Vec<Vec3>),
 }
 
-/// A grid's arrays, kept from pass to pass: above 32 MiB (VCM at
-/// 512×384) each was mapped afresh every pass and its pages faulted in
-/// again (`engine::heap`); and what a pass leaves in them is written over,
-/// never cleared first (cleared and refilled with defaults, the records
-/// were a fifth of the grid's time on gap-room).
+/// A grid's arrays, kept from pass to pass: above 32 MiB each would be
+/// mapped afresh every pass and its pages faulted in again
+/// (`engine::heap`); and what a pass leaves in them is written over, never
+/// cleared first.
 #[derive(Default)]
 pub struct MergeBuffers {
     by_vertex: Vec<MergeVertex>,

@@ -112,11 +112,9 @@ impl Bidir {
     /// 0.5% for VCM merging everywhere, whose connections carry most paths,
     /// so a wide radius buys little noise and costs bias: light leaking
     /// through a thin wall where a plane runs on past it (gap-room's
-    /// partition lit its far room's corners at 2%, 20 times too bright, and
-    /// held VCM's error above BDPT's at equal passes); 1% for VCM merging on
-    /// caustic paths, whose merges alone carry the paths they make (at 5–8 s,
-    /// relMSE against 0.5%: mirror-caustic 0.50, cornell 0.96, thesis 0.95,
-    /// caustics 0.99–1.01; at 2%, caustics 1.3, the caustic blurred).
+    /// partition); 1% for VCM merging on caustic paths, whose merges alone
+    /// carry the paths they make, where a wider radius blurs the caustic
+    /// (the measurements behind each are in docs/performance.md).
     pub fn new(world: &World, settings: &RenderSettings, visible_radius: f32) -> Self {
         let (mode, heuristic, radius, alpha, caustic_merges) = match &settings.method {
             Method::Bdpt(b) => (Mode::Connect, b.mis, 0.0, 1.0, false),

@@ -21,9 +21,8 @@ use crate::scene::Rgb;
 impl PathLanes {
     /// The radiance of every camera sample of `tile`, each handed to `out`
     /// with its index as its path ends. The film adds it there and then, so
-    /// fetching the pixel's sums overlaps the other lanes' work (a pass over
-    /// an array of samples after the tile waited on each cache line: 3% of
-    /// smallpt's time).
+    /// fetching the pixel's sums overlaps the other lanes' work, where a pass
+    /// over an array of samples after the tile would wait on each cache line.
     pub fn radiance(
         &self,
         world: &World,

@@ -29,9 +29,9 @@ impl GlossyLanes {
     pub(super) fn new(table: &SurfaceTable, index: Index8, code: F8, color: V8, alive: M8) -> Self {
         let phong = code.eq(F8::splat(PHONG)).and(alive);
         let blinn_phong = code.eq(F8::splat(BLINN_PHONG)).and(alive);
-        // The lobes' parameters gathered only where a lane is glossy: every
-        // bounce of a scene without a glossy surface gathered them for
-        // nothing (2.7% of smallpt's instructions)
+        // The lobes' parameters gathered only where a lane is glossy: a
+        // scene without a glossy surface would gather them at every bounce
+        // for nothing
         let (ks, exponent, diffuse_probability, normalisation) = match phong.or(blinn_phong).any() {
             true => (
                 table.specular.get(index),

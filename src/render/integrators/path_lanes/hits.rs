@@ -307,8 +307,7 @@ impl PathLanes {
 #[derive(Clone, Debug)]
 pub(super) struct LaneCull {
     /// Its edges, each coefficient splat into eight lanes, read straight
-    /// into the test: splat afresh, they were a fifth of the cull's
-    /// instructions.
+    /// into the test rather than splat afresh for every batch of rays.
     edges: LaneEdges,
     plane: CullPlane,
     /// Which run of triangles in one plane it belongs to
@@ -344,9 +343,9 @@ impl LaneEdges {
 pub(super) struct RunCrossing {
     run: u32,
     at: Crossing<F8>,
-    /// Worked out for every batch before the triangles (a division and the
-    /// axes' selects), it was 3.5% of the instructions of smallpt, which
-    /// has none; only a batch the cull lets through needs it.
+    /// Worked out only once a batch the cull lets through needs it (a
+    /// division and the axes' selects): a scene of no triangles, or rays
+    /// the cull decides, never pay for it.
     shear: Option<RayShear<F8>>,
 }
 

@@ -160,9 +160,9 @@ pub struct PathLanes {
     plane_normals: Column3,
     plane_offsets: Column,
     triangles: Vec<Triangle>,
-    /// What the cull reads of each triangle, in one record (read from the
-    /// triangle and a list of runs beside it, its loads and bounds checks
-    /// were 5% of gap-room's instructions).
+    /// What the cull reads of each triangle, in one record: one load
+    /// where the triangle and a list of runs beside it took several, each
+    /// with its bounds check.
     triangle_culls: Vec<LaneCull>,
     /// Each triangle's light plane (`World::light_plane`): a shadow ray
     /// toward a light on a triangle skips the triangles of its plane.

@@ -42,8 +42,8 @@ impl Lanes {
 
     /// Idle lanes take the next samples (from `next` on, below `count`):
     /// each sample's fields blended into its lane, the registers staying
-    /// registers (gathered for all eight lanes, or written lane by lane
-    /// into arrays and loaded back, they were 4% of smallpt's time).
+    /// registers, not gathered for all eight lanes nor written lane by lane
+    /// into arrays and loaded back.
     #[inline(always)]
     pub(super) fn start_idle(
         &mut self,

@@ -53,7 +53,7 @@ pub(super) type Run = (u32, u32);
 /// none touching the next.
 pub(super) enum Touched<'a> {
     /// Listed in room on the caller's stack: returned by value, the list
-    /// itself was copied once per query (1% of a VCM render's instructions).
+    /// itself would be copied once per query.
     Few(&'a [Run]),
     Many(Vec<Run>),
     /// More cells than buckets: every point is a candidate.
@@ -139,16 +139,14 @@ impl PointGrid {
 
     /// The scalar test (the same float operations) eight points at a
     /// time, the slots handed out in the same order: a VCM query tests a
-    /// few dozen points for one or two, and the test one at a time was 6%
-    /// of a VCM render.
+    /// few dozen points for one or two.
     #[inline(always)]
     fn slots_within_lanes(&self, touched: &Touched, point: Vec3, bound: f32, f: &mut impl FnMut(usize)) {
         let (px, py, pz) = (F8::splat(point.x), F8::splat(point.y), F8::splat(point.z));
         let bound = F8::splat(bound);
         let lane = F8::from_array([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
         // Every bucket's first points asked for at once, not one bucket's
-        // after another's (a merge's few buckets each miss the cache: BPM
-        // and VCM on gap-room at 256×192 took 0.976 and 0.967 of the time)
+        // after another's: a merge's few buckets each miss the cache
         if let Touched::Few(runs) = touched {
             for &(first, _) in *runs {
                 let start = self.starts[first as usize] as usize;
@@ -201,8 +199,8 @@ impl PointGrid {
     fn bucket(&self, cell: [i32; 3]) -> u32 {
         // Linear in x: a cell's neighbours along x are the next buckets, so
         // a query's cells share cache lines and their points lie side by
-        // side (SPPM's gather took 8–17% less time than with the
-        // scrambling hash of Teschner et al. that SmallVCM uses)
+        // side, where the scrambling hash of Teschner et al. that SmallVCM
+        // uses scatters them
         (cell[0] as u32)
             .wrapping_add((cell[1] as u32).wrapping_mul(19_349_663))
             .wrapping_add((cell[2] as u32).wrapping_mul(83_492_791))

@@ -253,8 +253,8 @@ impl PhotonKdTree {
                 // Ask now for the eight great-grandchildren (8i+7..8i+14, side
                 // by side: four prefetches over their 224 bytes), which the
                 // walk reaches three loads later. Each level below the cached
-                // top was a miss in turn: a final gather's queries, which land
-                // anywhere, took 1.3–1.5× as long without, random ones 2×.
+                // top would be a miss in turn, above all for a final gather's
+                // queries, which land anywhere.
                 for great_grandchild in [7, 9, 11, 14] {
                     if let Some(photon) = photons.get(8 * node + great_grandchild) {
                         prefetch(photon);

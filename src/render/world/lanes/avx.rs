@@ -224,8 +224,7 @@ impl F8 {
             let settled = one.select(F8::splat(1.0), F8::splat(0.0));
             // Only where a lane takes the fast path: the f64 evaluation of
             // what the other lanes hold (a point light's x⁰ in every lane)
-            // cost mirror-caustic's path tracing a tenth of its time, all
-            // of it in subnormal assists (flush-to-zero recovered the same)
+            // would spend its time in subnormal assists
             let power = if fast.any() {
                 // log₂ x's table index, exponent and reduced mantissa (`pow::log2_of`)
                 let from_offset = _mm256_sub_epi32(x_bits, _mm256_set1_epi32(pow::LOG2_OFFSET as i32));

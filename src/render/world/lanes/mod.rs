@@ -258,8 +258,7 @@ impl V3<F8> {
 /// Each lane's next draw is mixed ahead, as soon as the one before it is
 /// taken: a draw then hands out bits worked out long before, and the mix's
 /// latency (two 64-bit multiplies emulated by six) stays off the path's
-/// chain of dependent work (smallpt's lanes: 2–5% faster for the same
-/// instructions).
+/// chain of dependent work.
 #[derive(Clone, Copy, Debug)]
 pub struct Rng8 {
     state: [u64; LANES],
