@@ -17,18 +17,26 @@ pub mod triangles;
 use glam::Vec3;
 
 use crate::geometry::real::V3;
-use crate::geometry::sphere::{wall_exit, wall_exit_hit, wall_slack};
+use crate::geometry::sphere::{wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{plane_exit_t, plane_hit, plane_t, sphere_hit};
 use crate::geometry::{Ray, SurfaceHit, Triangle};
 use crate::scene::{LightKind, MaterialModel, Rgb, Shape, ValidScene};
 use camera::CameraModel;
 use light::{Emitter, EmitterCap, LightSource};
-use occluders::{Occluders, Shadow, Walls};
+use occluders::{Occluders, Shadow, WallPlane, Walls};
 pub use shapes::{ObjectInfo, PlaneShape, ShapeRef, Spheres};
 use spheres::SphereLanes;
 use triangles::TriangleLanes;
 
 /// What `intersect_held` found nearest.
+/// What `World::reach` gives a ray to meet.
+struct Reach<'w> {
+    spheres: &'w SphereLanes,
+    wall_spheres: &'w [(u32, AnchoredSphere)],
+    planes: &'w [PlaneShape],
+    wall_planes: &'w [WallPlane],
+}
+
 enum Inside<'w> {
     /// Sphere `i` of the world, entered (near root) or left.
     Sphere(u32, bool),
@@ -239,38 +247,24 @@ impl World {
     /// Nearest hit in (0, t_max).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let mut best_t = t_max;
-        let mut best = None;
-        let mut sphere_near = true;
-        let s = &self.spheres;
-        if let Some((i, t, near)) = s.lanes.nearest(ray, best_t) {
-            best_t = t;
-            best = Some(ShapeRef::Sphere(i as u32));
-            sphere_near = near;
+        self.intersect_held(ray, t_max, false)
+    }
+
+    /// What a ray meets from where it starts: every sphere and plane, or,
+    /// for a path held inside every wall, the spheres and planes that are
+    /// not walls, and the walls from inside.
+    #[inline]
+    fn reach(&self, held: bool) -> Reach<'_> {
+        let walls = &self.walls;
+        match held {
+            true => Reach {
+                spheres: &walls.spheres,
+                wall_spheres: &walls.wall_spheres,
+                planes: &walls.planes,
+                wall_planes: &walls.wall_planes,
+            },
+            false => Reach { spheres: &self.spheres.lanes, wall_spheres: &[], planes: &self.planes, wall_planes: &[] },
         }
-        for (i, plane) in self.planes.iter().enumerate() {
-            if let Some(t) = plane_t(ray, plane.normal, plane.offset, best_t) {
-                best_t = t;
-                best = Some(ShapeRef::Plane(i as u32));
-            }
-        }
-        let triangle_hit = self.triangle_lanes.nearest(&self.triangles, ray, best_t);
-        if let Some((i, hit)) = triangle_hit {
-            best_t = hit.t;
-            best = Some(ShapeRef::Triangle(i));
-        }
-        let (surface, object) = match best? {
-            ShapeRef::Sphere(i) => {
-                let i = i as usize;
-                (sphere_hit(ray, s.center(i), s.radius[i], best_t, sphere_near), s.object[i])
-            }
-            ShapeRef::Plane(i) => {
-                let plane = &self.planes[i as usize];
-                (plane_hit(ray, plane.normal, plane.offset, best_t), plane.object)
-            }
-            ShapeRef::Triangle(i) => (triangle_hit?.1, self.triangles[i as usize].1),
-        };
-        Some(Hit { surface, object, material: self.objects[object as usize].material })
     }
 
     /// Whether a path starting at `origin` is inside every wall (see
@@ -303,19 +297,16 @@ impl World {
     /// leaves the room.
     #[inline]
     pub fn intersect_held(&self, ray: &Ray, t_max: f32, held: bool) -> Option<Hit> {
-        if !held {
-            return self.intersect(ray, t_max);
-        }
-        let walls = &self.walls;
+        let reach = self.reach(held);
         let s = &self.spheres;
         let mut best_t = t_max;
         let mut best = None;
-        if let Some((i, t, near)) = walls.spheres.nearest(ray, best_t) {
+        if let Some((i, t, near)) = reach.spheres.nearest(ray, best_t) {
             best_t = t;
-            best = Some(Inside::Sphere(walls.spheres.id(i), near));
+            best = Some(Inside::Sphere(reach.spheres.id(i), near));
         }
         let (origin, direction) = (V3::from(ray.origin), V3::from(ray.direction));
-        for (k, (_, wall)) in walls.wall_spheres.iter().enumerate() {
+        for (k, (_, wall)) in reach.wall_spheres.iter().enumerate() {
             let (anchor, normal) = (V3::from(wall.anchor), V3::from(wall.normal));
             let (t, hit) = wall_exit(origin, direction, anchor, normal, wall.radius, best_t);
             if hit {
@@ -323,13 +314,13 @@ impl World {
                 best = Some(Inside::Wall(k));
             }
         }
-        for plane in &walls.planes {
+        for plane in reach.planes {
             if let Some(t) = plane_t(ray, plane.normal, plane.offset, best_t) {
                 best_t = t;
                 best = Some(Inside::Plane(plane));
             }
         }
-        for wall in &walls.wall_planes {
+        for wall in reach.wall_planes {
             if let Some(t) = plane_exit_t(ray, wall.inward, wall.offset, best_t) {
                 best_t = t;
                 best = Some(Inside::Plane(&wall.plane));
@@ -346,7 +337,7 @@ impl World {
                 (sphere_hit(ray, s.center(i), s.radius[i], best_t, near), s.object[i])
             }
             Inside::Wall(k) => {
-                let (i, wall) = &walls.wall_spheres[k];
+                let (i, wall) = &reach.wall_spheres[k];
                 let center = V3::from(s.center(*i as usize));
                 let (point, normal, error) = wall_exit_hit(origin, direction, best_t, center, wall_slack(wall));
                 let surface = SurfaceHit { t: best_t, point: point.into(), normal: normal.into(), error };
