@@ -242,7 +242,8 @@ fn a_merged_reference_is_the_one_bench_measures_against() {
     let bench = ["bench", &scene, "--budget", "0.05", "--algos", "path", "--reference-budget", "0", "--out", "bench"];
     let (code, text) = run(&bench, elsewhere.path());
     assert_eq!((code, text.contains("no reference for")), (Some(1), true), "{text}");
-    let flags = ["--algo", "path", "--spp", "16", "--width", "32", "--height", "24"];
+    // The Cornell box's reference method: light comes through glass
+    let flags = ["--algo", "bdpt", "--spp", "16", "--width", "32", "--height", "24"];
     for shard in ["0/2", "1/2"] {
         let part = format!("part-{}.exr", &shard[..1]);
         let (code, text) = run(&[&["render", &scene, "-o", &part, "--shard", shard][..], &flags].concat(), d);

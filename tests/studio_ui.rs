@@ -679,7 +679,8 @@ fn an_edited_scene_is_measured_against_a_reference_made_in_the_background() {
     let mut harness =
         Harness::builder().with_size([1400.0, 900.0]).build_ui_state(|ui, app: &mut StudioApp| app.show(ui), app);
     step_long_until(&mut harness, |app| matches!(app.references().source(), Some(Source::Rendering(_))));
-    harness.get_by_label_contains("path tracing");
+    // The box's glass ball: BDPT finds its caustic
+    harness.get_by_label_contains("bidirectional path tracing");
     step_long_until(
         &mut harness,
         |app| matches!(app.panes().list()[0].state().latest_error(), Some(PaneError::Measured(e)) if e.rel_mse.is_finite()),
@@ -713,7 +714,7 @@ fn an_edited_scene_is_measured_against_a_reference_made_in_the_background() {
     step_long_until(&mut harness, |app| app.references().source() == Some(&Source::Cache));
     assert_eq!(kept(cache.path()), 1, "nothing rendered again");
     harness.run_steps(2);
-    harness.get_by_label_contains("from the cache (path, 4096 of 4096 spp, its own relMSE");
+    harness.get_by_label_contains("from the cache (bdpt, 4096 of 4096 spp, its own relMSE");
     // …and can be rendered again on the user's word
     harness.get_by_label("Render again").click();
     harness.run_steps(2);
