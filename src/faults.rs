@@ -21,16 +21,19 @@ pub enum Fault {
     PhotonPowerHigh,
     /// A bug that panics while a job is prepared, on a render worker.
     RenderPanics,
+    /// SPPM's density estimate (flux over the gather disc's area) 2% too high.
+    SppmDensityHigh,
 }
 
 impl Fault {
-    pub const ALL: [Fault; 6] = [
+    pub const ALL: [Fault; 7] = [
         Fault::PhongLobeDim,
         Fault::SppmRadiusFixed,
         Fault::LightPdfOff,
         Fault::RouletteUndivided,
         Fault::PhotonPowerHigh,
         Fault::RenderPanics,
+        Fault::SppmDensityHigh,
     ];
 }
 

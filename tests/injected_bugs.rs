@@ -13,7 +13,7 @@ type Detector = (&'static str, fn() -> Result<(), String>);
 
 #[test]
 fn each_detector_fires_on_its_injected_bug() {
-    let catches: [(Fault, &[Detector]); 6] = [
+    let catches: [(Fault, &[Detector]); 7] = [
         (Fault::PhongLobeDim, &[("Phong's closed form", detectors::phong_lobes_reflect_everything)]),
         (Fault::SppmRadiusFixed, &[("SPPM's shrinking radius", detectors::sppm_radius_shrinks)]),
         (Fault::LightPdfOff, &[("MIS under a giant light", detectors::mis_under_a_giant_light_holds_the_closed_form)]),
@@ -26,6 +26,7 @@ fn each_detector_fires_on_its_injected_bug() {
         ),
         (Fault::PhotonPowerHigh, &[("photon mapping's energy", detectors::photon_mapping_holds_path_tracings_energy)]),
         (Fault::RenderPanics, &[("a render's end", detectors::renders_end_and_sessions_go_on)]),
+        (Fault::SppmDensityHigh, &[("SPPM in the furnace", detectors::sppm_holds_the_furnace)]),
     ];
     assert_eq!(catches.len(), Fault::ALL.len(), "every fault has its detectors");
     for (fault, detectors) in catches {

@@ -46,7 +46,8 @@ fn glass_conserves_energy_and_reflects_totally() {
 /// mapping and photon mapping with ρ = ½ (radiance 1) within 2.5% and 4%,
 /// their bias (the gather disc reaching round the sphere's curve, fixed-k's
 /// blur) plus 4σ of their noise (σ ≈ 0.4%, over seeds); Whitted gives the
-/// direct light alone, ½, exactly.
+/// direct light alone, ½, exactly; and SPPM, gathering over a wide disc,
+/// within about 0.5% (`detectors::sppm_holds_the_furnace`).
 #[test]
 fn an_analytic_furnace_converges_to_its_closed_form() {
     if let Err(e) = detectors::path_tracing_holds_the_furnace() {
@@ -64,6 +65,9 @@ fn an_analytic_furnace_converges_to_its_closed_form() {
     assert!((mapped - 1.0).abs() < 0.04, "photon mapping: {mapped}");
     let direct = mean_luminance(&render(&inside, settings(Algorithm::Whitted, 16, 12, 1)).0.pixels);
     assert!((direct - 0.5).abs() < 1e-3, "whitted: {direct}");
+    if let Err(e) = detectors::sppm_holds_the_furnace() {
+        panic!("{e}");
+    }
 }
 
 /// Samples with u → 1, zero-length normals and a = b = c = 0 refused,

@@ -196,7 +196,10 @@ impl SppmPixel {
         if passes == 0 {
             return Rgb::ZERO;
         }
-        let indirect = if self.radius > 0.0 { self.flux / (PI * self.radius * self.radius) } else { Rgb::ZERO };
+        let mut indirect = if self.radius > 0.0 { self.flux / (PI * self.radius * self.radius) } else { Rgb::ZERO };
+        if faults::active(Fault::SppmDensityHigh) {
+            indirect *= 1.02;
+        }
         (self.direct + indirect) / passes as f32
     }
 
