@@ -17,7 +17,7 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("cornell", "whitted", 0x80aa3c0ec2f92365),
     ("cornell", "path", 0x2f882b069bbc2cc9),
     ("cornell", "photon", 0x3e7ca4681f1e2767),
-    ("cornell", "sppm", 0xf69a7f9309ec557a),
+    ("cornell", "sppm", 0x12cfbeae302927cf),
     ("smallpt", "whitted", 0x88fbbc44b9345a5b),
     ("smallpt", "path", 0xce8e33ea0c87c9a0),
     ("smallpt", "photon", 0xb778cd9064e34996),

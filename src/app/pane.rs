@@ -21,7 +21,7 @@ use crate::render::unseen::unseen_lights;
 use crate::render::world::camera::TileRect;
 use crate::render::{
     Algorithm, LinearImage, Method, MisHeuristic, PassStats, RenderEvent, RenderJob, RenderSession, RenderSettings,
-    Switch, Workers,
+    Switch, Workers, DEPTH_MEANING,
 };
 use crate::scene::ValidScene;
 
@@ -451,7 +451,8 @@ impl Pane {
         let time = number(&mut budget).range(0.0..=limits::SECONDS.max).speed(0.5);
         ui.add(time.prefix("time budget s (0: none) "));
         s.time_limit = (budget > 0.0).then_some(budget);
-        ui.add(number(&mut s.max_depth).range(range(limits::MAX_DEPTH)).prefix("max depth "));
+        ui.add(number(&mut s.max_depth).range(range(limits::MAX_DEPTH)).prefix("max depth "))
+            .on_hover_text(DEPTH_MEANING);
         ui.add(number(&mut s.width).range(16..=4096).prefix("width "));
         ui.add(number(&mut s.height).range(16..=4096).prefix("height "));
         let mis_ui = |ui: &mut egui::Ui, mis: &mut MisHeuristic| {

@@ -243,6 +243,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let name = &subject.name;
         let (width, height) = (reference.image.width, reference.image.height);
         println!("\n{name} at {width}×{height} for {} s per algorithm (reference: {made})", args.budget);
+        println!(
+            "paths of up to {} segments, camera to light (Whitted: {})",
+            Algorithm::Path.default_max_depth(),
+            Algorithm::Whitted.default_max_depth()
+        );
         let mut runs = Vec::new();
         for &algorithm in &args.algos {
             let mut settings = RenderSettings {

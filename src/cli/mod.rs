@@ -15,7 +15,7 @@ pub mod shard;
 use clap::{Args, Parser, Subcommand};
 
 use crate::limits;
-use crate::render::{Algorithm, MergeSettings, Method, MisHeuristic, PhotonSettings, SppmSettings};
+use crate::render::{Algorithm, MergeSettings, Method, MisHeuristic, PhotonSettings, SppmSettings, DEPTH_MEANING};
 use merges::Merges;
 
 /// The headless commands alone (the binary adds the studio's flags).
@@ -65,8 +65,7 @@ pub struct RenderFlags {
     /// Worker threads (0: every core).
     #[arg(long, default_value_t = 0, value_parser = |s: &str| limits::THREADS.parse(s))]
     pub threads: usize,
-    /// Longest path (the algorithm's default if not given).
-    #[arg(long, value_parser = |s: &str| limits::MAX_DEPTH.parse(s))]
+    #[arg(long, help = DEPTH_MEANING, value_parser = |s: &str| limits::MAX_DEPTH.parse(s))]
     pub max_depth: Option<u32>,
     /// Exposure in stops for PNG output (the scene's if not given).
     #[arg(long, value_parser = |s: &str| limits::EXPOSURE_STOPS.parse(s))]

@@ -26,4 +26,5 @@ pub use image::LinearImage;
 pub use integrators::PhotonPassStats;
 pub use settings::{
     Algorithm, BidirSettings, MergeSettings, Method, MisHeuristic, PhotonSettings, RenderSettings, SppmSettings,
+    DEPTH_MEANING,
 };

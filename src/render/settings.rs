@@ -86,11 +86,13 @@ impl Algorithm {
         matches!(self, Algorithm::Path | Algorithm::LightTracing | Algorithm::Bdpt)
     }
 
-    /// The thesis' depth 5 for Whitted; the Monte Carlo methods end paths by
-    /// Russian roulette well before their cap.
+    /// The longest path each draws by default (`RenderSettings::max_depth`):
+    /// the thesis' five rays for Whitted, with its shadow ray six segments;
+    /// the Monte Carlo methods end paths by Russian roulette well before
+    /// their cap.
     pub fn default_max_depth(self) -> u32 {
         match self {
-            Algorithm::Whitted => 5,
+            Algorithm::Whitted => 6,
             _ => 32,
         }
     }
@@ -275,6 +277,12 @@ pub struct RenderSettings {
     /// Stop once this many seconds have passed (checked between passes).
     pub time_limit: Option<f64>,
     pub seed: u64,
+    /// The longest path, in segments from the camera to a light, for every
+    /// algorithm: 1 sees the lights, 2 adds their direct light, each more one
+    /// more bounce. (Whitted always shades what the camera sees. Photon
+    /// mapping's and SPPM's photons fly at most `max_depth` − 1 segments, not
+    /// knowing how far the camera came: through mirrors or glass, the paths
+    /// they gather can be longer.)
     pub max_depth: u32,
     /// Off (0) by default: clamping hides bias. When set, each sample's
     /// channels are limited to this value.
@@ -283,6 +291,11 @@ pub struct RenderSettings {
     pub preview: bool,
     pub tile_size: u32,
 }
+
+/// What `RenderSettings::max_depth` means, as the CLI's help and the
+/// studio's tooltip say it.
+pub const DEPTH_MEANING: &str = "The longest path, in segments from the camera to a light, for every \
+    algorithm: 1 sees the lights, 2 adds their direct light, each more one more bounce";
 
 impl Default for RenderSettings {
     fn default() -> Self {

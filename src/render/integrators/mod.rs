@@ -61,7 +61,7 @@ impl Integrator {
     ) -> Option<Self> {
         let settings = stage.settings;
         Some(match &settings.method {
-            Method::Whitted => Integrator::Whitted(whitted::Whitted::new(settings.max_depth.max(1))),
+            Method::Whitted => Integrator::Whitted(whitted::Whitted::new(settings.max_depth)),
             Method::Path => Integrator::Path(path::PathTracer::new(settings.max_depth)),
             Method::Photon(photon) => {
                 let maps = match maps {

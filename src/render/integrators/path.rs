@@ -49,6 +49,10 @@ impl PathTracer {
     }
 }
 
+/// Radiance along `ray` carried by paths of at most `max_depth` segments
+/// (`RenderSettings::max_depth`): at the last segment's end only what it
+/// sees glowing counts, both ways of finding a path of that length (light
+/// sampling and the BSDF's) held to the same cap.
 pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
     let scope = PathScope::new(world, ray.origin);
     let mut ray = *ray;
@@ -81,6 +85,9 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
                 _ => 1.0,
             };
             radiance += throughput * emitted * weight;
+        }
+        if depth + 1 == max_depth {
+            break;
         }
 
         let bsdf = Bsdf::new(world.material_of(&hit));

@@ -22,8 +22,10 @@ use crate::render::world::rng::Sampler;
 use crate::render::world::{Hit, World};
 use crate::scene::Rgb;
 
-/// Specular bounces a gather ray may follow before it must find a surface.
-const GATHER_SPECULAR_DEPTH: u32 = 4;
+/// A gather ray's segments through mirrors and glass, the one to its surface
+/// included, and one more (`follow_specular` keeps a segment for the light
+/// gathered there): it finds its surface after at most three bounces.
+const GATHER_SPECULAR_DEPTH: u32 = 5;
 
 /// What one tile reuses between camera samples: no allocation per ray.
 pub struct PhotonScratch {

@@ -70,6 +70,11 @@ impl Chain {
             self.radiance += self.throughput * world.emitted(&hit, wo);
         }
         let bsdf = Bsdf::new(world.material_of(&hit));
+        // A landing gathers light over one segment more (a shadow ray's, a
+        // photon's): at the last segment's end there is none left
+        if self.segments == 1 {
+            return Some((self.radiance, None));
+        }
         if !bsdf.is_specular() {
             return Some((self.radiance, Some(Landing { hit, wo, bsdf, throughput: self.throughput })));
         }
@@ -79,12 +84,13 @@ impl Chain {
         self.throughput *= s.weight;
         self.ray = hit.surface.spawn_ray(s.wi);
         self.segments -= 1;
-        (self.segments == 0).then_some((self.radiance, None))
+        None
     }
 }
 
 /// Follow `ray` for at most `max_depth` segments: the radiance gathered on
-/// the way and the landing, if the path reaches one.
+/// the way and the landing, if the path reaches one before its last
+/// segment's end.
 pub fn follow_specular(
     scope: &PathScope,
     ray: &Ray,

@@ -258,7 +258,9 @@ impl<'w> Flights<'_, 'w> {
         let light = &world.lights[index];
         let (u1, u2) = (sampler.next_2d(), sampler.next_2d());
         let emission = light.emit(ctx.bounds, u1, u2);
-        if !(emission.pdf > 0.0 && emission.power.is_finite()) || ctx.max_length == 0 {
+        // A light subpath's first vertex is a segment from the light and
+        // one more from the camera: shorter paths need none
+        if !(emission.pdf > 0.0 && emission.power.is_finite()) || ctx.max_length < 2 {
             return None;
         }
         Some(Flight {

@@ -125,10 +125,8 @@ impl PathLanes {
         if !alive.any() {
             return missed;
         }
-        let surfaces = LaneSurfaces::new(&self.surfaces, shape, alive);
-        let LaneSurfaces { emissive, ref glossy, color, .. } = surfaces;
-        // What next-event estimation shades
-        let diffuse = surfaces.lambert.or(glossy.mask());
+        let mut surfaces = LaneSurfaces::new(&self.surfaces, shape, alive);
+        let (emissive, color) = (surfaces.emissive, surfaces.color);
         let wo = -direction;
         let hit = |i: usize| SurfaceHit {
             t: t_hit.lane(i),
@@ -153,6 +151,14 @@ impl PathLanes {
             let sum = st.radiance.lane(lane) + st.throughput.lane(lane) * surface.color * weight;
             st.radiance.set_lane(lane, sum);
         }
+        // A path at its last segment's end neither samples a light nor scatters
+        let last = alive.and(st.depth.ge(max_depth - 1));
+        if last.any() {
+            surfaces.keep(alive.and_not(last));
+        }
+        let glossy = &surfaces.glossy;
+        // What next-event estimation shades
+        let diffuse = surfaces.lambert.or(glossy.mask());
 
         let facing = normal.dot(wo).lt(F8::splat(0.0)).select_v(-normal, normal);
         let zero = F8::splat(0.0);
@@ -242,6 +248,6 @@ impl PathLanes {
         st.origin = go.select_v(offset_origin(point, error, normal, wi), st.origin);
         st.direction = go.select_v(wi, st.direction);
         st.depth = st.depth.count_in(go);
-        done.or(killed).or(go.and(st.depth.ge(max_depth)))
+        done.or(killed)
     }
 }

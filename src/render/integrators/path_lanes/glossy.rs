@@ -49,6 +49,13 @@ impl GlossyLanes {
         self.phong.or(self.blinn_phong)
     }
 
+    /// Only the lanes of `lanes` left.
+    #[inline(always)]
+    pub(super) fn keep(&mut self, lanes: M8) {
+        self.phong = self.phong.and(lanes);
+        self.blinn_phong = self.blinn_phong.and(lanes);
+    }
+
     /// `Bsdf::eval_pdf` for `wo` and `wi` above the surface of normal `n`.
     #[inline(always)]
     pub(super) fn f_pdf(&self, wo: V8, wi: V8, n: V8) -> (V8, F8) {

@@ -60,6 +60,16 @@ impl<'a> LaneSurfaces<'a> {
         }
     }
 
+    /// Only the lanes of `lanes` left (the others' surfaces scatter nothing).
+    #[inline(always)]
+    pub(super) fn keep(&mut self, lanes: M8) {
+        self.lambert = self.lambert.and(lanes);
+        self.mirror = self.mirror.and(lanes);
+        self.glass = self.glass.and(lanes);
+        self.emissive = self.emissive.and(lanes);
+        self.glossy.keep(lanes);
+    }
+
     /// `Bsdf::is_specular`: mirrors, glass, and what reflects nothing.
     #[inline(always)]
     pub(crate) fn specular(&self) -> M8 {

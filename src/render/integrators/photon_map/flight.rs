@@ -56,7 +56,9 @@ pub(super) struct Tracing<'a> {
     targets: Vec<(Vec3, f32)>,
     /// 1 / the photon count: each stored power's share.
     scale: f32,
-    max_depth: u32,
+    /// The most segments a photon flies: a path's, less the camera's one
+    /// to the surface that gathers it.
+    segments: u32,
     /// The photons' random streams in this pass.
     streams: PassStreams,
 }
@@ -91,7 +93,8 @@ impl<'a> Tracing<'a> {
             return None;
         }
         let streams = PassStreams::new(pass, seed ^ PHOTON_SALT ^ kind as u64);
-        Some(Tracing { world, kind, picker, targets, scale: 1.0 / count as f32, max_depth, streams })
+        let segments = max_depth.saturating_sub(1);
+        Some(Tracing { world, kind, picker, targets, scale: 1.0 / count as f32, segments, streams })
     }
 
     pub(super) fn world(&self) -> &'a World {
@@ -120,8 +123,8 @@ impl<'a> Tracing<'a> {
         self.kind
     }
 
-    pub(super) fn max_depth(&self) -> u32 {
-        self.max_depth
+    pub(super) fn segments(&self) -> u32 {
+        self.segments
     }
 
     /// Photon `index`, leaving its light: None if it leaves none, or may
@@ -133,7 +136,7 @@ impl<'a> Tracing<'a> {
             MapKind::Caustic => emit_toward(world, &self.picker, &self.targets, &mut sampler),
             _ => emit(world, &self.picker, &mut sampler),
         };
-        let EmittedPhoton { ray, power } = emitted.filter(|_| self.max_depth > 0)?;
+        let EmittedPhoton { ray, power } = emitted.filter(|_| self.segments > 0)?;
         let scale = self.power_scale();
         let held = world.holds(ray.origin);
         Some(Flight { ray, held, power: power * scale, depth: 0, diffuse_bounces: 0, sampler })
@@ -177,6 +180,6 @@ impl<'a> Tracing<'a> {
         }
         flight.ray = hit.surface.spawn_ray(scattered.wi);
         flight.depth += 1;
-        flight.depth < self.max_depth
+        flight.depth < self.segments
     }
 }

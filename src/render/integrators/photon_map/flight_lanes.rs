@@ -100,7 +100,7 @@ impl Tracing<'_> {
         if self.kind() == MapKind::Caustic {
             return self.launch_one_by_one(st, next, indices);
         }
-        if self.max_depth() == 0 {
+        if self.segments() == 0 {
             *next = indices.end;
             return;
         }
@@ -209,6 +209,6 @@ impl Tracing<'_> {
         st.origin = go.select_v(offset_origin(hits.point, hits.error, normal, wi), st.origin);
         st.direction = go.select_v(wi, st.direction);
         st.depth = st.depth.count_in(go);
-        st.active = go.and_not(st.depth.ge(self.max_depth()));
+        st.active = go.and_not(st.depth.ge(self.segments()));
     }
 }

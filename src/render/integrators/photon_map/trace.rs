@@ -30,6 +30,7 @@ pub struct PhotonBatch {
     pub count: u64,
     pub pass: u64,
     pub seed: u64,
+    /// The longest path, camera to light (`RenderSettings::max_depth`).
     pub max_depth: u32,
 }
 
@@ -203,12 +204,13 @@ mod tests {
         assert!(stored > 1000, "three of each kind: only {stored} photons stored");
     }
 
-    /// Photons that end at the depth cap, or before any bounce.
+    /// Photons that end at the depth cap, or before any bounce: paths of
+    /// one segment leave none for a photon.
     #[test]
     fn short_flights_end_at_the_depth_cap() {
         for depth in [0, 1, 2, 3] {
             let stored = assert_lanes_store_what_one_by_one_does("caustics", preset("caustics"), depth);
-            assert_eq!(stored == 0, depth == 0, "depth {depth}: {stored} photons stored");
+            assert_eq!(stored == 0, depth <= 1, "depth {depth}: {stored} photons stored");
         }
     }
 

@@ -24,19 +24,22 @@ use crate::render::world::World;
 use crate::scene::Rgb;
 use shading::{branches, combine, light_term, lit_cosine, shades};
 
-/// Whitted ray tracing, recursing at most `max_depth` times.
+/// Whitted ray tracing: at most `rays` rays in a chain through mirrors and
+/// glass, each hit lit by shadow rays.
 pub struct Whitted {
-    pub max_depth: u32,
+    pub rays: u32,
 }
 
 impl Whitted {
+    /// Paths of at most `max_depth` segments, the shadow ray's included;
+    /// what the camera sees is always shaded.
     pub fn new(max_depth: u32) -> Self {
-        Self { max_depth }
+        Self { rays: max_depth.saturating_sub(1).max(1) }
     }
 
     #[inline]
     pub fn radiance(&self, world: &World, ray: &Ray, sampler: &mut Sampler, counters: &mut Counters) -> Rgb {
-        radiance(world, ray, self.max_depth, sampler, counters)
+        radiance(world, ray, self.rays, sampler, counters)
     }
 
     /// One sample of every pixel of `tile`, each handed to `out` with its
@@ -49,7 +52,7 @@ impl Whitted {
         counters: &mut Counters,
     ) {
         let mut values = vec![Rgb::ZERO; tile.len()];
-        waves::render_tile(stage.world, stage.lanes, tile, self.max_depth, &mut values, counters);
+        waves::render_tile(stage.world, stage.lanes, tile, self.rays, &mut values, counters);
         values.into_iter().enumerate().for_each(|(i, value)| out(i, value));
     }
 }
