@@ -171,7 +171,7 @@ fn camera_partials(path: &RandomPath, camera: &CameraModel, s: &Strategies, i: u
 /// estimation, each connection, the join to the camera, each merge.
 fn weights(path: &RandomPath, light: &LightSource, camera: &CameraModel, s: &Strategies) -> Vec<f32> {
     let (k, pick) = (path.k(), 0.7);
-    let bounds = Bounds { center: Vec3::ZERO, radius: 100.0 };
+    let bounds = Bounds { lo: Vec3::splat(-100.0), hi: Vec3::splat(100.0) };
     let mut weights = Vec::new();
     if s.connect {
         if !light.is_delta() {

@@ -3,52 +3,103 @@
 //! sampling between paths from the camera and paths from the lights needs
 //! those densities for any point on a light, not only sampled ones
 //! (`emission_pdf`, `direct_pdf_a`). Infinite lights (directional, the
-//! background) emit from a disc covering the region the camera sees, as far
-//! behind it as its radius.
+//! background) emit from a rectangle covering the shadow of the region the
+//! camera sees (`Bounds`).
 
 use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
 use super::light::{spot_factor, Emitter, LightSource};
-use super::sampling::{concentric_disk, cosine_hemisphere, uniform_cone, uniform_cone_pdf, uniform_sphere};
+use super::sampling::{cosine_hemisphere, uniform_cone, uniform_cone_pdf, uniform_sphere};
 use super::sampling::{uniform_sphere_pdf, uniform_triangle};
 use crate::geometry::{offset_ray_origin, pow, Frame, Ray, SurfaceHit};
 use crate::scene::Rgb;
 
-/// The region infinite lights must light: a sphere about what the camera
-/// sees (`World::cover`).
+/// The box infinite lights must light (`World::bounds`). Light from a
+/// direction starts on the rectangle, across the direction and behind the
+/// box, that covers the box's shadow: a light path's power is the
+/// rectangle's area times the light, so a cover no larger than the box's
+/// shadow wastes few paths and gives each little power (a disc about the
+/// box's ball was several times its shadow, and light subpaths that only
+/// they can make — caustics seen in a mirror — that much noisier).
 #[derive(Clone, Copy, Debug)]
 pub struct Bounds {
-    pub center: Vec3,
-    pub radius: f32,
+    pub lo: Vec3,
+    pub hi: Vec3,
+}
+
+/// Where light along one direction starts: `Bounds::cover`.
+struct Cover {
+    frame: Frame,
+    x: (f32, f32),
+    y: (f32, f32),
+    /// The box's nearest extent along the direction.
+    back: f32,
+}
+
+impl Cover {
+    fn area(&self) -> f32 {
+        (self.x.1 - self.x.0) * (self.y.1 - self.y.0)
+    }
 }
 
 impl Bounds {
-    /// Where light travelling along `direction` leaves the disc covering
-    /// the region: `u` on the disc.
-    fn disc_origin(&self, direction: Vec3, u: Vec2) -> Ray {
+    /// The rectangle covering the box's shadow across `direction`.
+    fn cover(&self, direction: Vec3) -> Cover {
         let frame = Frame::from_z(direction);
-        let disc = concentric_disk(u) * self.radius;
-        let origin = self.center - direction * (2.0 * self.radius) + frame.x * disc.x + frame.y * disc.y;
-        Ray::new(origin, direction)
+        let (mut x, mut y, mut back) =
+            ((f32::INFINITY, f32::NEG_INFINITY), (f32::INFINITY, f32::NEG_INFINITY), f32::INFINITY);
+        for corner in 0..8 {
+            let pick = |bit: u32, lo: f32, hi: f32| if corner & bit == 0 { lo } else { hi };
+            let p =
+                Vec3::new(pick(1, self.lo.x, self.hi.x), pick(2, self.lo.y, self.hi.y), pick(4, self.lo.z, self.hi.z));
+            let (u, v) = (p.dot(frame.x), p.dot(frame.y));
+            (x, y) = ((x.0.min(u), x.1.max(u)), (y.0.min(v), y.1.max(v)));
+            back = back.min(p.dot(direction));
+        }
+        Cover { frame, x, y, back }
     }
 
-    /// The disc's density of origins, where the line through `point` along
-    /// `direction` crosses it (0 outside: no light path from the disc
-    /// reaches `point` that way).
-    fn disc_pdf(&self, point: Vec3, direction: Vec3) -> f32 {
-        let offset = point - self.center;
-        let across = offset - direction * offset.dot(direction);
-        if across.length_squared() <= self.radius * self.radius {
-            1.0 / (PI * self.radius * self.radius)
+    /// Where light travelling along `direction` starts: `u` on the cover,
+    /// a box's diagonal behind it.
+    fn start(&self, direction: Vec3, u: Vec2) -> Ray {
+        let Cover { frame, x, y, back } = self.cover(direction);
+        let (a, b) = (x.0 + (x.1 - x.0) * u.x, y.0 + (y.1 - y.0) * u.y);
+        let behind = back - (self.hi - self.lo).length().max(1e-3);
+        Ray::new(frame.x * a + frame.y * b + direction * behind, direction)
+    }
+
+    /// The cover's density of starts, where the line through `point` along
+    /// `direction` crosses it (0 outside: no light path from it reaches
+    /// `point` that way).
+    fn start_pdf(&self, point: Vec3, direction: Vec3) -> f32 {
+        let cover = self.cover(direction);
+        let (u, v) = (point.dot(cover.frame.x), point.dot(cover.frame.y));
+        let inside = (cover.x.0..=cover.x.1).contains(&u) && (cover.y.0..=cover.y.1).contains(&v);
+        let area = cover.area();
+        if inside && area > 0.0 {
+            1.0 / area
         } else {
             0.0
         }
     }
 
-    fn disc_area(&self) -> f32 {
-        PI * self.radius * self.radius
+    /// The cover's area across `direction`.
+    fn area(&self, direction: Vec3) -> f32 {
+        self.cover(direction).area().max(0.0)
+    }
+
+    /// The box's mean shadow over all directions: a quarter of its surface.
+    fn mean_shadow(&self) -> f32 {
+        let d = (self.hi - self.lo).max(Vec3::ZERO);
+        (d.x * d.y + d.y * d.z + d.z * d.x) * 0.5
+    }
+
+    /// The box grown by `factor` about its centre.
+    pub fn grown(self, factor: f32) -> Bounds {
+        let (centre, half) = ((self.lo + self.hi) * 0.5, (self.hi - self.lo) * 0.5 * factor);
+        Bounds { lo: centre - half, hi: centre + half }
     }
 }
 
@@ -74,7 +125,8 @@ pub struct Emission {
 }
 
 impl LightSource {
-    /// Total emitted power.
+    /// Total emitted power (for the background, over the mean cover, taken
+    /// as the box's mean shadow: a quarter of its surface, by Cauchy).
     pub fn power(&self, bounds: Bounds) -> Rgb {
         match *self {
             LightSource::Point { intensity, .. } => intensity * (4.0 * PI),
@@ -82,9 +134,9 @@ impl LightSource {
                 // ∫ over the cone of cos^σ θ dω = 2π (1 − cos^{σ+1} θc)/(σ + 1)
                 intensity * (2.0 * PI * (1.0 - pow::powf(cos_cone, exponent + 1.0)) / (exponent + 1.0))
             }
-            LightSource::Directional { irradiance, .. } => irradiance * bounds.disc_area(),
+            LightSource::Directional { irradiance, direction } => irradiance * bounds.area(direction),
             LightSource::Area { radiance, ref emitter, .. } => radiance * (PI * emitter.area()),
-            LightSource::Background { radiance } => radiance * (4.0 * PI * bounds.disc_area()),
+            LightSource::Background { radiance } => radiance * (4.0 * PI * bounds.mean_shadow()),
         }
     }
 
@@ -95,8 +147,8 @@ impl LightSource {
 
     /// Sample a start of light from two uniform pairs: `u1` for a point or
     /// spot light's direction, an area light's point, a directional light's
-    /// disc and the background's direction; `u2` for an area light's
-    /// direction and the background's disc.
+    /// cover and the background's direction; `u2` for an area light's
+    /// direction and the background's cover.
     pub fn emit(&self, bounds: Bounds, u1: Vec2, u2: Vec2) -> Emission {
         match *self {
             LightSource::Point { position, intensity, .. } => Emission {
@@ -116,18 +168,18 @@ impl LightSource {
                 Emission { ray: Ray::new(position, d), power, pdf, cos: 1.0, point: position, normal: Vec3::ZERO }
             }
             LightSource::Directional { direction, irradiance } => {
-                let ray = bounds.disc_origin(direction, u1);
-                let (power, pdf) = (irradiance * bounds.disc_area(), 1.0 / bounds.disc_area());
+                let (ray, area) = (bounds.start(direction, u1), bounds.area(direction));
+                let (power, pdf) = (irradiance * area, if area > 0.0 { 1.0 / area } else { 0.0 });
                 Emission { ray, power, pdf, cos: 1.0, point: ray.origin, normal: Vec3::ZERO }
             }
             LightSource::Background { radiance } => {
                 // Light from every direction: it travels along −ω for a sky direction ω
                 let direction = -uniform_sphere(u1);
-                let ray = bounds.disc_origin(direction, u2);
+                let (ray, area) = (bounds.start(direction, u2), bounds.area(direction));
                 Emission {
                     ray,
-                    power: radiance * (4.0 * PI * bounds.disc_area()),
-                    pdf: uniform_sphere_pdf() / bounds.disc_area(),
+                    power: radiance * (4.0 * PI * area),
+                    pdf: if area > 0.0 { uniform_sphere_pdf() / area } else { 0.0 },
                     cos: 1.0,
                     point: ray.origin,
                     normal: Vec3::ZERO,
@@ -164,8 +216,8 @@ impl LightSource {
                     0.0
                 }
             }
-            LightSource::Directional { .. } => bounds.disc_pdf(point, direction),
-            LightSource::Background { .. } => uniform_sphere_pdf() * bounds.disc_pdf(point, direction),
+            LightSource::Directional { .. } => bounds.start_pdf(point, direction),
+            LightSource::Background { .. } => uniform_sphere_pdf() * bounds.start_pdf(point, direction),
             LightSource::Area { ref emitter, .. } => {
                 let cos = normal.dot(direction);
                 if cos <= 0.0 || !emitter.emits_at(point) {
@@ -208,6 +260,47 @@ pub fn point_on_emitter(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f32) {
             let (b0, b1) = uniform_triangle(u);
             let [a, b, c] = triangle.vertices;
             (a * b0 + b * b1 + c * (1.0 - b0 - b1), triangle.normal, emitter.error())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::world::rng::Sampler;
+
+    /// Light from any direction into a box starts behind it, on a cover
+    /// whose density is the same wherever it starts and nothing where no
+    /// start lies: every point of the box is reached (its line crosses the
+    /// cover) and the cover is no larger than the box's shadow needs (each
+    /// side touched by a corner's line).
+    #[test]
+    fn the_cover_of_a_box_is_behind_it_holds_its_shadow_and_its_density_is_even() {
+        let bounds = Bounds { lo: Vec3::new(-1.0, 0.0, -2.0), hi: Vec3::new(3.0, 0.5, 1.0) };
+        let mut s = Sampler::new(0, 0, 11);
+        for _ in 0..200 {
+            let direction = uniform_sphere(s.next_2d());
+            let area = bounds.area(direction);
+            assert!(area > 0.0);
+            for _ in 0..20 {
+                let start = bounds.start(direction, s.next_2d());
+                assert_eq!(start.direction, direction);
+                let corners_ahead = (0..8).all(|c| {
+                    let corner =
+                        Vec3::select(glam::BVec3::new(c & 1 == 0, c & 2 == 0, c & 4 == 0), bounds.lo, bounds.hi);
+                    (corner - start.origin).dot(direction) > 0.0
+                });
+                assert!(corners_ahead, "a start in front of the box");
+                let pdf = bounds.start_pdf(start.origin + direction * 0.5, direction);
+                assert!((pdf * area - 1.0).abs() < 1e-4, "density {pdf} on a cover of area {area}");
+                let inside = bounds.lo + (bounds.hi - bounds.lo) * Vec3::new(s.next_f32(), s.next_f32(), s.next_f32());
+                assert!(bounds.start_pdf(inside, direction) > 0.0, "{inside} unreached along {direction}");
+            }
+            // Far to the side of the box, across the direction: no start
+            let Cover { frame, x, .. } = bounds.cover(direction);
+            let beside = frame.x * (x.1 + 1.0) + (bounds.lo + bounds.hi) * 0.5
+                - frame.x * frame.x.dot((bounds.lo + bounds.hi) * 0.5);
+            assert_eq!(bounds.start_pdf(beside, direction), 0.0);
         }
     }
 }

@@ -69,6 +69,11 @@ pub struct World {
     /// excluded), or around what the camera sees once `cover` was called.
     pub bounds_center: Vec3,
     pub bounds_radius: f32,
+    /// The same as a box, tight about them (`bounds`, `seen_bounds`).
+    region: emission::Bounds,
+    /// How much wider than `region` photons must start: half again once
+    /// `cover`ed, for light that bounces in from just outside the view.
+    region_margin: f32,
     /// Spheres and planes that shadow rays from inside may skip (see `Occluders`).
     pub(crate) walls: Walls,
     /// Per triangle, the first light triangle whose plane holds it, if any
@@ -134,6 +139,8 @@ impl World {
             ambient: scene.ambient,
             bounds_center: Vec3::ZERO,
             bounds_radius: 0.0,
+            region: emission::Bounds { lo: Vec3::ZERO, hi: Vec3::ZERO },
+            region_margin: 1.0,
             walls: Walls::default(),
             light_plane: Vec::new(),
         };
@@ -175,6 +182,7 @@ impl World {
         if lo.x <= hi.x {
             world.bounds_center = (lo + hi) * 0.5;
             world.bounds_radius = (hi - lo).length() * 0.5;
+            world.region = emission::Bounds { lo, hi };
         }
         // Disabled lights are simply absent from the render
         for light in scene.lights.iter().filter(|l| l.enabled) {
@@ -395,10 +403,11 @@ impl World {
         (rms.is_finite() && rms > 0.0).then_some(rms)
     }
 
-    /// Make the photon-emission region (the directional lights' disc, and
-    /// the part of giant emitters photons leave from) the bounding sphere of
-    /// the visible points, with a margin for light that bounces in from just
-    /// outside the view, and fit the emitters' caps to what `camera` can see.
+    /// Make the region infinite lights must light (`bounds`, `seen_bounds`)
+    /// and the part of giant emitters photons leave from (the bounding
+    /// sphere) what the camera sees, with a margin for light that bounces in
+    /// from just outside the view, and fit the emitters' caps to what
+    /// `camera` can see.
     /// The bounds of all finite objects would not do when walls are spheres
     /// of radius 1e5.
     /// `points` are what the camera sees (`region_points`).
@@ -406,6 +415,9 @@ impl World {
         if let Some((center, radius)) = bounding_ball(points) {
             self.bounds_center = center;
             self.bounds_radius = radius;
+            let (lo, hi) =
+                points.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+            (self.region, self.region_margin) = (emission::Bounds { lo, hi }, 1.5);
         }
         let eye = camera.central_origin();
         self.fit_caps(Some(eye));
@@ -503,10 +515,20 @@ impl World {
         EmitterCap::inside(center, radius, region, extent)
     }
 
-    /// The region infinite lights must light (`cover`).
+    /// The region infinite lights must light for the photons (`cover`):
+    /// what the camera sees, with a margin, since light that bounces in
+    /// from outside it is lost to them.
     #[inline]
     pub fn bounds(&self) -> emission::Bounds {
-        emission::Bounds { center: self.bounds_center, radius: self.bounds_radius }
+        self.region.grown(self.region_margin)
+    }
+
+    /// What the camera sees, without the margin: for light subpaths whose
+    /// paths the camera's own subpaths can make too, where light comes from
+    /// outside it (multiple importance sampling gives those paths to them).
+    #[inline]
+    pub fn seen_bounds(&self) -> emission::Bounds {
+        self.region
     }
 
     #[inline]

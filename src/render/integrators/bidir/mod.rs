@@ -158,6 +158,17 @@ impl Bidir {
         (self.radius / ((pass + 1) as f32).powf(0.5 * (1.0 - self.alpha))).max(1e-7)
     }
 
+    /// Where light subpaths from infinite lights start: what the camera sees
+    /// where connections can carry the light that comes from outside it
+    /// (BDPT, VCM); with the photons' margin where nothing else would
+    /// (light tracing, bidirectional photon mapping).
+    fn light_region(&self, world: &World) -> Bounds {
+        match self.mode {
+            Mode::Connect | Mode::ConnectAndMerge => world.seen_bounds(),
+            Mode::LightTracing | Mode::Merge => world.bounds(),
+        }
+    }
+
     /// The strategies of pass `pass` over `pixels` pixels, and how they weigh.
     fn weighing(&self, pass: u32, pixels: f32) -> Strategies {
         let connect = matches!(self.mode, Mode::Connect | Mode::ConnectAndMerge);
@@ -192,7 +203,7 @@ impl Bidir {
             camera: stage.camera,
             strategies: weighing,
             picker: &self.picker,
-            bounds: world.bounds(),
+            bounds: self.light_region(world),
             background,
             max_length: self.max_length,
             light_tracing: self.mode == Mode::LightTracing,

@@ -462,7 +462,7 @@ mod tests {
                         (one_minus_cos / one_minus_cos_max) as f64
                     } else {
                         let offset = (to - d * to.dot(d)).length();
-                        let upstream = to.dot(d) > 0.0 && o.distance(world.bounds().center) >= world.bounds().radius;
+                        let upstream = to.dot(d) > 0.0 && o.distance(world.bounds_center) >= world.bounds_radius;
                         assert!(upstream && offset <= radius * 1.001, "{name}: from {o} along {d}");
                         ((offset / radius) as f64).powi(2)
                     }
