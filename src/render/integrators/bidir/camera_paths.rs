@@ -379,7 +379,7 @@ fn emitter_weight(
     let pick = ctx.picker.probability(index as usize);
     let (point, normal) = (hit.surface.point, hit.surface.normal);
     let direct = pick * light.direct_pdf_a(last_point, point, normal);
-    let emission = pick * light.emission_pdf(ctx.bounds, point, normal, wo);
+    let emission = pick * light.emission_pdf(ctx.bounds_of(light), point, normal, wo);
     mis::hit_light(&ctx.strategies, partials, direct, emission)
 }
 
@@ -404,7 +404,7 @@ fn background_weight(
     let pick = ctx.picker.probability(index);
     let light = &ctx.world.lights[index];
     let direct = pick * uniform_sphere_pdf();
-    let emission = pick * light.emission_pdf(ctx.bounds, last_point, Vec3::ZERO, -direction);
+    let emission = pick * light.emission_pdf(ctx.bounds_of(light), last_point, Vec3::ZERO, -direction);
     mis::hit_light(&ctx.strategies, partials, direct, emission)
 }
 
@@ -443,7 +443,7 @@ fn direct(
     };
     // Infinite lights emit toward the lit point from their disc
     let from = if light.is_finite() { sample.point } else { point };
-    let emission_pdf = light.emission_pdf(ctx.bounds, from, sample.normal, -sample.wi);
+    let emission_pdf = light.emission_pdf(ctx.bounds_of(light), from, sample.normal, -sample.wi);
     let go_on = bsdf.continuation();
     let bsdf_pdf = if light.is_delta() { 0.0 } else { pdf * go_on };
     let reverse = bsdf.pdf(sample.wi, wo, facing) * go_on;
@@ -584,6 +584,7 @@ mod tests {
                     strategies: Strategies::with_merges(MisHeuristic::Power, true, true, caustics, pixels, radius),
                     picker: &picker,
                     bounds: world.bounds(),
+                    sky_bounds: world.bounds(),
                     background: world.lights.iter().position(|l| matches!(l, LightSource::Background { .. })),
                     max_length: 8,
                     light_tracing: false,

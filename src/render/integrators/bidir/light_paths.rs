@@ -257,7 +257,7 @@ impl<'w> Flights<'_, 'w> {
         let (index, pick) = ctx.picker.pick(sampler.next_f32())?;
         let light = &world.lights[index];
         let (u1, u2) = (sampler.next_2d(), sampler.next_2d());
-        let emission = light.emit(ctx.bounds, u1, u2);
+        let emission = light.emit(ctx.bounds_of(light), u1, u2);
         // A light subpath's first vertex is a segment from the light and
         // one more from the camera: shorter paths need none
         if !(emission.pdf > 0.0 && emission.power.is_finite()) || ctx.max_length < 2 {
@@ -480,6 +480,7 @@ mod tests {
                         strategies: Strategies::new(MisHeuristic::Power, connect, merge, pixels, visible_radius * 0.01),
                         picker: &picker,
                         bounds: world.bounds(),
+                        sky_bounds: world.bounds(),
                         background: world.lights.iter().position(|l| matches!(l, LightSource::Background { .. })),
                         max_length,
                         light_tracing,

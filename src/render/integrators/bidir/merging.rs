@@ -148,6 +148,7 @@ mod tests {
             strategies: Strategies::with_merges(MisHeuristic::Power, true, true, true, pixels, radius),
             picker: &picker,
             bounds: world.bounds(),
+            sky_bounds: world.bounds(),
             background: None,
             max_length: 8,
             light_tracing: false,

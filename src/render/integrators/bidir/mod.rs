@@ -86,7 +86,10 @@ pub struct Context<'a> {
     pub camera: &'a CameraModel,
     pub strategies: Strategies,
     pub picker: &'a LightPicker,
+    /// Where light from the directional lights starts (`Bidir::light_region`).
     pub bounds: Bounds,
+    /// Where the background's starts: the photons' region.
+    pub sky_bounds: Bounds,
     /// The background light, if the scene has one.
     pub background: Option<usize>,
     /// Longest path, in segments.
@@ -102,6 +105,15 @@ impl Context<'_> {
     /// Whether light vertices are kept (to connect or merge).
     pub fn keeps_vertices(&self) -> bool {
         self.strategies.connect || self.strategies.merge
+    }
+
+    /// Where light from `light` starts, if it is infinite.
+    #[inline]
+    pub fn bounds_of(&self, light: &LightSource) -> Bounds {
+        match light {
+            LightSource::Background { .. } => self.sky_bounds,
+            _ => self.bounds,
+        }
     }
 }
 
@@ -158,10 +170,13 @@ impl Bidir {
         (self.radius / ((pass + 1) as f32).powf(0.5 * (1.0 - self.alpha))).max(1e-7)
     }
 
-    /// Where light subpaths from infinite lights start: what the camera sees
-    /// where connections can carry the light that comes from outside it
-    /// (BDPT, VCM); with the photons' margin where nothing else would
-    /// (light tracing, bidirectional photon mapping).
+    /// Where light subpaths from directional lights start: what the camera
+    /// sees where connections can carry the light that comes from outside
+    /// it (BDPT, VCM); with the photons' margin where nothing else would
+    /// (light tracing, bidirectional photon mapping). The background's
+    /// always start with the margin: camera subpaths find the sky well by
+    /// themselves, and more light subpaths in the region seen cost more
+    /// time than they save there.
     fn light_region(&self, world: &World) -> Bounds {
         match self.mode {
             Mode::Connect | Mode::ConnectAndMerge => world.seen_bounds(),
@@ -204,6 +219,7 @@ impl Bidir {
             strategies: weighing,
             picker: &self.picker,
             bounds: self.light_region(world),
+            sky_bounds: world.bounds(),
             background,
             max_length: self.max_length,
             light_tracing: self.mode == Mode::LightTracing,
