@@ -62,12 +62,13 @@ impl Bounds {
     }
 
     /// Where light travelling along `direction` starts: `u` on the cover,
-    /// a box's diagonal behind it.
-    fn start(&self, direction: Vec3, u: Vec2) -> Ray {
-        let Cover { frame, x, y, back } = self.cover(direction);
+    /// a box's diagonal behind it; and the cover's area.
+    fn start(&self, direction: Vec3, u: Vec2) -> (Ray, f32) {
+        let cover = self.cover(direction);
+        let Cover { frame, x, y, back } = cover;
         let (a, b) = (x.0 + (x.1 - x.0) * u.x, y.0 + (y.1 - y.0) * u.y);
         let behind = back - (self.hi - self.lo).length().max(1e-3);
-        Ray::new(frame.x * a + frame.y * b + direction * behind, direction)
+        (Ray::new(frame.x * a + frame.y * b + direction * behind, direction), cover.area().max(0.0))
     }
 
     /// The cover's density of starts, where the line through `point` along
@@ -168,14 +169,14 @@ impl LightSource {
                 Emission { ray: Ray::new(position, d), power, pdf, cos: 1.0, point: position, normal: Vec3::ZERO }
             }
             LightSource::Directional { direction, irradiance } => {
-                let (ray, area) = (bounds.start(direction, u1), bounds.area(direction));
+                let (ray, area) = bounds.start(direction, u1);
                 let (power, pdf) = (irradiance * area, if area > 0.0 { 1.0 / area } else { 0.0 });
                 Emission { ray, power, pdf, cos: 1.0, point: ray.origin, normal: Vec3::ZERO }
             }
             LightSource::Background { radiance } => {
                 // Light from every direction: it travels along −ω for a sky direction ω
                 let direction = -uniform_sphere(u1);
-                let (ray, area) = (bounds.start(direction, u2), bounds.area(direction));
+                let (ray, area) = bounds.start(direction, u2);
                 Emission {
                     ray,
                     power: radiance * (4.0 * PI * area),
@@ -283,7 +284,7 @@ mod tests {
             let area = bounds.area(direction);
             assert!(area > 0.0);
             for _ in 0..20 {
-                let start = bounds.start(direction, s.next_2d());
+                let (start, _) = bounds.start(direction, s.next_2d());
                 assert_eq!(start.direction, direction);
                 let corners_ahead = (0..8).all(|c| {
                     let corner =
