@@ -81,14 +81,20 @@ pub struct World {
     pub(crate) light_plane: Vec<u32>,
 }
 
+/// `points`' box (None without points).
+fn bounding_box(points: &[Vec3]) -> Option<emission::Bounds> {
+    let (lo, hi) = points.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    (lo.x <= hi.x).then_some(emission::Bounds { lo, hi })
+}
+
 /// A ball about `points`' box, half again as wide: (centre, radius).
 fn bounding_ball(points: &[Vec3]) -> Option<(Vec3, f32)> {
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for p in points {
-        lo = lo.min(*p);
-        hi = hi.max(*p);
-    }
-    (lo.x <= hi.x).then(|| ((lo + hi) * 0.5, (hi - lo).length() * 0.75))
+    bounding_box(points).map(ball_about)
+}
+
+/// The ball about `bounds`, half again as wide: (centre, radius).
+fn ball_about(emission::Bounds { lo, hi }: emission::Bounds) -> (Vec3, f32) {
+    ((lo + hi) * 0.5, (hi - lo).length() * 0.75)
 }
 
 /// The visible points that say how large the scene is: all of them, but
@@ -412,12 +418,9 @@ impl World {
     /// of radius 1e5.
     /// `points` are what the camera sees (`region_points`).
     pub fn cover(&mut self, points: &[Vec3], camera: &CameraModel) {
-        if let Some((center, radius)) = bounding_ball(points) {
-            self.bounds_center = center;
-            self.bounds_radius = radius;
-            let (lo, hi) =
-                points.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-            (self.region, self.region_margin) = (emission::Bounds { lo, hi }, 1.5);
+        if let Some(region) = bounding_box(points) {
+            (self.bounds_center, self.bounds_radius) = ball_about(region);
+            (self.region, self.region_margin) = (region, 1.5);
         }
         let eye = camera.central_origin();
         self.fit_caps(Some(eye));
