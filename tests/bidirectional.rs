@@ -10,10 +10,10 @@ mod common;
 use common::*;
 use gi_studio::geometry::SurfaceHit;
 use gi_studio::render::integrators::bidir::mis::{self, MergeBehind, Partials, Strategies};
-use gi_studio::render::world::bsdf::Bsdf;
 use gi_studio::render::world::camera::CameraModel;
 use gi_studio::render::world::emission::Bounds;
 use gi_studio::render::world::light::LightSource;
+use gi_studio::render::world::materials::Bsdf;
 use gi_studio::render::world::rng::Sampler;
 use gi_studio::render::world::World;
 use gi_studio::render::MisHeuristic;
@@ -65,10 +65,10 @@ fn try_random_path(segments: usize, s: &mut Sampler) -> Option<RandomPath> {
     }
     let bsdfs = (0..=segments)
         .map(|i| match (s.next_f32() * 3.0) as u32 {
-            _ if mirror[i] => Bsdf::Mirror { tint: Vec3::splat(0.5 + 0.5 * s.next_f32()) },
-            0 => Bsdf::Lambert { albedo: Vec3::splat(0.2 + 0.7 * s.next_f32()) },
-            1 => Bsdf::Phong { kd: Vec3::splat(0.4), ks: Vec3::splat(0.5), exponent: 1.0 + 30.0 * s.next_f32() },
-            _ => Bsdf::BlinnPhong { kd: Vec3::splat(0.3), ks: Vec3::splat(0.6), exponent: 1.0 + 60.0 * s.next_f32() },
+            _ if mirror[i] => Bsdf::mirror(Vec3::splat(0.5 + 0.5 * s.next_f32())),
+            0 => Bsdf::lambert(Vec3::splat(0.2 + 0.7 * s.next_f32())),
+            1 => Bsdf::phong(Vec3::splat(0.4), Vec3::splat(0.5), 1.0 + 30.0 * s.next_f32()),
+            _ => Bsdf::blinn_phong(Vec3::splat(0.3), Vec3::splat(0.6), 1.0 + 60.0 * s.next_f32()),
         })
         .collect();
     Some(RandomPath { points, normals, bsdfs })

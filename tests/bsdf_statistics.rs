@@ -5,7 +5,7 @@ mod common;
 use common::detectors::{self, albedo_by_quadrature};
 use common::stats::{ChiSquare, DirectionBins};
 
-use gi_studio::render::world::bsdf::{Bsdf, Transport};
+use gi_studio::render::world::materials::{Bsdf, Transport};
 use gi_studio::render::world::rng::Sampler;
 use glam::Vec3;
 
@@ -22,12 +22,12 @@ fn chi_square(bsdf: &Bsdf, wo: Vec3, bins: DirectionBins) -> ChiSquare {
 #[test]
 fn every_bsdf_conserves_energy_and_samples_its_pdf() {
     let bsdfs = [
-        Bsdf::Lambert { albedo: Vec3::ONE },
-        Bsdf::Phong { kd: Vec3::splat(0.3), ks: Vec3::splat(0.7), exponent: 20.0 },
-        Bsdf::Phong { kd: Vec3::ZERO, ks: Vec3::ONE, exponent: 500.0 },
-        Bsdf::BlinnPhong { kd: Vec3::splat(0.4), ks: Vec3::splat(0.6), exponent: 80.0 },
-        Bsdf::BlinnPhong { kd: Vec3::ZERO, ks: Vec3::ONE, exponent: 5.0 },
-        Bsdf::Glass { ior: 1.5, tint: Vec3::ONE },
+        Bsdf::lambert(Vec3::ONE),
+        Bsdf::phong(Vec3::splat(0.3), Vec3::splat(0.7), 20.0),
+        Bsdf::phong(Vec3::ZERO, Vec3::ONE, 500.0),
+        Bsdf::blinn_phong(Vec3::splat(0.4), Vec3::splat(0.6), 80.0),
+        Bsdf::blinn_phong(Vec3::ZERO, Vec3::ONE, 5.0),
+        Bsdf::glass(1.5, Vec3::ONE),
     ];
     let mut s = Sampler::new(140, 0, 140);
     for bsdf in &bsdfs {
@@ -40,20 +40,20 @@ fn every_bsdf_conserves_energy_and_samples_its_pdf() {
                 .sum::<f64>()
                 / n as f64;
             assert!(energy <= 1.0 + 0.01, "{bsdf:?} at {theta}°: energy {energy}");
-            if matches!(bsdf, Bsdf::Lambert { .. } | Bsdf::Glass { .. }) {
+            if matches!(bsdf, Bsdf::Lambert(_) | Bsdf::Glass(_)) {
                 assert!(energy > 0.99, "{bsdf:?} at {theta}°: loses energy ({energy})");
             }
             // Bins over the hemisphere, or for a lobe too sharp for them (a
             // pure Phong lobe of exponent 500 is 4° wide) a window about the
             // mirror direction holding 99.9% of it: P(cos α < c) = c^(n+1)
             let bins = match bsdf {
-                Bsdf::Phong { kd, exponent, .. } if *kd == Vec3::ZERO && *exponent > 100.0 => {
-                    let span = 1.0 - 0.001f64.powf(1.0 / (*exponent as f64 + 1.0));
+                Bsdf::Phong(phong) if phong.kd == Vec3::ZERO.into() && phong.exponent > 100.0 => {
+                    let span = 1.0 - 0.001f64.powf(1.0 / (phong.exponent as f64 + 1.0));
                     DirectionBins::cone(Vec3::new(-wo.x, -wo.y, wo.z), span, 10, 20)
                 }
                 _ => DirectionBins::cone(Vec3::Z, 1.0, 10, 20),
             };
-            if !matches!(bsdf, Bsdf::Glass { .. }) && theta < 80.0 {
+            if !matches!(bsdf, Bsdf::Glass(_)) && theta < 80.0 {
                 // p > 1e-4: a false alarm one run in 10 000 per lobe and angle
                 let result = chi_square(bsdf, wo, bins);
                 assert!(
@@ -84,11 +84,11 @@ fn every_lobe_reflects_its_closed_form_and_sampling_agrees_both_ways() {
     }
 
     let bsdfs = [
-        Bsdf::Lambert { albedo: Vec3::splat(0.8) },
-        Bsdf::Phong { kd: Vec3::splat(0.3), ks: Vec3::splat(0.6), exponent: 20.0 },
-        Bsdf::Phong { kd: Vec3::ZERO, ks: Vec3::ONE, exponent: 100.0 },
-        Bsdf::BlinnPhong { kd: Vec3::splat(0.4), ks: Vec3::splat(0.5), exponent: 80.0 },
-        Bsdf::BlinnPhong { kd: Vec3::ZERO, ks: Vec3::ONE, exponent: 5.0 },
+        Bsdf::lambert(Vec3::splat(0.8)),
+        Bsdf::phong(Vec3::splat(0.3), Vec3::splat(0.6), 20.0),
+        Bsdf::phong(Vec3::ZERO, Vec3::ONE, 100.0),
+        Bsdf::blinn_phong(Vec3::splat(0.4), Vec3::splat(0.5), 80.0),
+        Bsdf::blinn_phong(Vec3::ZERO, Vec3::ONE, 5.0),
     ];
     let mut s = Sampler::new(7, 0, 2025);
     for bsdf in &bsdfs {

@@ -9,7 +9,7 @@ use common::*;
 use gi_studio::analysis::metrics::{rel_mse, RelMseOptions};
 use gi_studio::render::integrators::photon_map::maps::{estimate, QueryStats};
 use gi_studio::render::integrators::photon_map::{Neighbours, Photon, PhotonKdTree};
-use gi_studio::render::world::bsdf::Bsdf;
+use gi_studio::render::world::materials::Bsdf;
 use gi_studio::render::{Algorithm, LinearImage, RenderJob};
 use gi_studio::scene::presets;
 use glam::Vec3;
@@ -18,7 +18,7 @@ use glam::Vec3;
 /// all photons at one point (r = 0), fewer than 8 found, photons from behind.
 #[test]
 fn awkward_photon_maps_give_finite_estimates() {
-    let bsdf = Bsdf::Lambert { albedo: Vec3::splat(0.5) };
+    let bsdf = Bsdf::lambert(Vec3::splat(0.5));
     let (p, n) = (Vec3::ZERO, Vec3::Y);
     let mut neighbours = Neighbours::new(50);
     let mut stats = QueryStats::default();

@@ -5,7 +5,7 @@ mod common;
 
 use common::detectors;
 use common::*;
-use gi_studio::render::world::bsdf::{Bsdf, Transport};
+use gi_studio::render::world::materials::{Bsdf, Transport};
 use gi_studio::render::world::rng::Sampler;
 use gi_studio::render::world::sampling::{cosine_hemisphere, power_cosine, uniform_cone, uniform_sphere};
 use gi_studio::render::{Algorithm, Method, RenderSettings};
@@ -35,7 +35,7 @@ fn glass_conserves_energy_and_reflects_totally() {
     let wo = Vec3::new(80f32.to_radians().sin(), 0.0, 80f32.to_radians().cos());
     let mut s = Sampler::new(12, 0, 12);
     for _ in 0..100 {
-        let b = Bsdf::Glass { ior: 1.5, tint: Vec3::ONE }.sample(wo, -Vec3::Z, &mut s, Transport::Radiance).unwrap();
+        let b = Bsdf::glass(1.5, Vec3::ONE).sample(wo, -Vec3::Z, &mut s, Transport::Radiance).unwrap();
         assert!(b.wi.z > 0.0 && (b.wi - Vec3::new(-wo.x, 0.0, wo.z)).length() < 1e-5);
     }
 }

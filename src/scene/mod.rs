@@ -149,6 +149,16 @@ impl MaterialModel {
             Self::Emissive { .. } => "Emissive",
         }
     }
+
+    /// The thesis' ambient colour: the share of the scene's ambient light
+    /// a surface gives back (only Whitted's models read it).
+    pub fn ambient_colour(&self) -> Rgb {
+        match *self {
+            Self::Lambert { albedo } => albedo,
+            Self::Phong { ka, .. } | Self::BlinnPhong { ka, .. } => ka,
+            Self::Mirror { .. } | Self::Glass { .. } | Self::Emissive { .. } => Rgb::ZERO,
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -11,7 +11,7 @@ use std::f32::consts::PI;
 use super::stats::{sidak, student_t_quantile};
 use super::*;
 use gi_studio::analysis::reference::embedded;
-use gi_studio::render::world::bsdf::Bsdf;
+use gi_studio::render::world::materials::Bsdf;
 use gi_studio::render::{Algorithm, LinearImage, RenderEvent, RenderSession, Workers};
 use gi_studio::scene::{presets, LightKind, MaterialModel, Scene, Shape};
 use glam::Vec3;
@@ -69,12 +69,12 @@ pub fn albedo_by_quadrature(bsdf: &Bsdf, wo: Vec3, n: usize) -> f64 {
 /// (its own error < 1e-4 here, checked against Lambert's albedo), so a
 /// bound of 1e-3 has no false alarms; a lobe 3% too dark fails it.
 pub fn phong_lobes_reflect_everything() -> Result<(), String> {
-    let lambert = albedo_by_quadrature(&Bsdf::Lambert { albedo: Vec3::splat(0.6) }, Vec3::Z, 2000);
+    let lambert = albedo_by_quadrature(&Bsdf::lambert(Vec3::splat(0.6)), Vec3::Z, 2000);
     if (lambert - 0.6).abs() > 1e-4 {
         return Err(format!("the quadrature itself is off: Lambert 0.6 reflects {lambert}"));
     }
     for exponent in [1.0, 5.0, 20.0, 100.0] {
-        let phong = Bsdf::Phong { kd: Vec3::ZERO, ks: Vec3::ONE, exponent };
+        let phong = Bsdf::phong(Vec3::ZERO, Vec3::ONE, exponent);
         let albedo = albedo_by_quadrature(&phong, Vec3::Z, 2000);
         if (albedo - 1.0).abs() > 1e-3 {
             return Err(format!("the Phong lobe of exponent {exponent} reflects {albedo}, not 1"));

@@ -25,8 +25,8 @@ use crate::faults::{self, Fault};
 use crate::geometry::Ray;
 use crate::render::film::Film;
 use crate::render::settings::{RenderSettings, SppmSettings};
-use crate::render::world::bsdf::Bsdf;
 use crate::render::world::camera::CameraTile;
+use crate::render::world::materials::Bsdf;
 use crate::render::world::rng::Sampler;
 use crate::render::world::World;
 use crate::scene::Rgb;
@@ -355,7 +355,7 @@ mod tests {
                 point: Vec3::ZERO,
                 facing: Vec3::Y,
                 wo: Vec3::Y,
-                bsdf: Bsdf::Lambert { albedo: Vec3::splat(0.5) },
+                bsdf: Bsdf::lambert(Vec3::splat(0.5)),
                 throughput: Rgb::ONE,
             });
             pixel.gather(&grid, 2.0 / 3.0);

@@ -2,11 +2,11 @@
 //! structure of arrays for the nearest-hit loop), materials and lights
 //! resolved to indices, disabled lights dropped.
 
-pub mod bsdf;
 pub mod camera;
 pub mod emission;
 pub(crate) mod lanes;
 pub mod light;
+pub mod materials;
 pub mod occluders;
 pub mod rng;
 pub mod sampling;

@@ -1,8 +1,6 @@
 //! One bounce of eight paths: `path::radiance`'s loop body lane by lane,
 //! and the loop that keeps the lanes busy with the tile's samples.
 
-use std::f32::consts::FRAC_1_PI;
-
 use super::lights::LightLanes;
 use super::samples::CameraSamples;
 use super::shadows::Skips;
@@ -11,9 +9,9 @@ use super::{LaneHits, LaneSurfaces, PathLanes, Scattered};
 use crate::faults::{self, Fault};
 use crate::geometry::{offset_origin, SurfaceHit};
 use crate::render::integrators::{Counters, ROULETTE_DEPTH};
-use crate::render::world::bsdf::Transport;
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
+use crate::render::world::materials::Transport;
 use crate::render::world::sampling::{power_heuristic, power_heuristic_of, uniform_sphere_pdf};
 use crate::render::world::World;
 use crate::scene::Rgb;
@@ -156,9 +154,8 @@ impl PathLanes {
         if last.any() {
             surfaces.keep(alive.and_not(last));
         }
-        let glossy = &surfaces.glossy;
         // What next-event estimation shades
-        let diffuse = surfaces.lambert.or(glossy.mask());
+        let diffuse = surfaces.shaded();
 
         let facing = normal.dot(wo).lt(F8::splat(0.0)).select_v(-normal, normal);
         let zero = F8::splat(0.0);
@@ -188,15 +185,9 @@ impl PathLanes {
         let Scattered { go, wi, weight, pdf, .. } =
             surfaces.scatter(&mut st.rng, wo, normal, facing, Transport::Radiance);
         if let Some((pick, light)) = shading {
-            // f (Lambert's albedo / π) where both directions are above the surface
+            // f where both directions are above the surface
             let above = !light.wi.dot(facing).le(zero).or(wo.dot(facing).le(zero));
-            let mut f = color * F8::splat(FRAC_1_PI);
-            let mut glossy_pdf = None;
-            if glossy.mask().and(light.valid).and(above).any() {
-                let (glossy_f, pdf) = glossy.f_pdf(wo, light.wi, facing);
-                f = glossy.mask().select_v(glossy_f, f);
-                glossy_pdf = Some(pdf);
-            }
+            let (f, bsdf_pdf) = surfaces.eval_pdf(light.valid.and(above), wo, light.wi, facing);
             let shade = light.valid.and(above).and(f.nonzero());
             counters.rays += shade.count();
             if shade.any() {
@@ -210,10 +201,6 @@ impl PathLanes {
                 let lit = shade.and_not(blocked);
                 if lit.any() {
                     let cos = light.wi.dot(facing);
-                    let mut bsdf_pdf = cos.max(zero) * FRAC_1_PI;
-                    if let Some(pdf) = glossy_pdf {
-                        bsdf_pdf = glossy.mask().select(pdf, bsdf_pdf);
-                    }
                     let mis = power_heuristic_of(pick_pdf * light.pdf, bsdf_pdf);
                     let weight = light.delta.select(F8::splat(1.0), mis);
                     let term = st.throughput * f * light.value * (cos * weight / pick_pdf);

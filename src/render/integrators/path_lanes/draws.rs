@@ -11,10 +11,10 @@ use glam::{Vec2, Vec3};
 use super::lights::LightLanes;
 use super::{LaneHits, LaneSurfaces, PathLanes, Scattered};
 use crate::geometry::{Ray, SurfaceHit};
-use crate::render::world::bsdf::{BsdfSample, Transport};
 use crate::render::world::camera::{CameraConnection, CameraModel, ConnectionOf};
 use crate::render::world::lanes::{self, Rng8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSample, LightSource};
+use crate::render::world::materials::{BsdfSample, Transport};
 use crate::render::world::rng::Sampler;
 use crate::render::world::World;
 
@@ -79,7 +79,7 @@ impl PathLanes {
     ) {
         let wanted = hits.found.and(M8::from_fn(|i| wants[i].is_some()));
         let surfaces = LaneSurfaces::new(&self.surfaces, hits.shape, wanted);
-        let drawing = surfaces.lambert.or(surfaces.glossy.mask());
+        let drawing = surfaces.shaded();
         if !drawing.any() {
             given.iter_mut().for_each(|g| *g = None);
             return;

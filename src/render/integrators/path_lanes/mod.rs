@@ -15,65 +15,34 @@
 //! loop meets them, what shading needs of each, lights, occluders); in
 //! `hits` the hit loop, in `shadows` the shadow test, in `bounce` a bounce
 //! of eight paths and the loop around it, in `state` the paths in flight;
-//! `draws`, `scatter`, `glossy` and `lights` sample in the lanes what the
-//! scalar code samples one at a time, and `wall_exits` asks a room of
+//! `draws` and `lights` sample in the lanes what the scalar code samples
+//! one at a time (the materials' own lanes are `world::materials::lanes`), and `wall_exits` asks a room of
 //! walls where a held ray leaves it.
 
 use glam::Vec3;
 
 mod bounce;
 mod draws;
-mod glossy;
 mod hits;
 mod lights;
 mod samples;
-mod scatter;
 mod shadows;
 mod state;
-mod surface_table;
 mod wall_exits;
 
 pub(crate) use draws::{Given, PickedLight, Want};
 use hits::{lane_culls, LaneCull};
 pub(crate) use lights::EmittedLanes;
 use lights::LaneLights;
-pub(crate) use scatter::{LaneSurfaces, Scattered};
-use surface_table::SurfaceTable;
 use wall_exits::WallExits;
 
 use crate::geometry::sphere::{wall_slack, AnchoredSphere};
 use crate::geometry::{gamma, Triangle};
-use crate::render::world::bsdf::{blinn_normalisation, Bsdf};
 use crate::render::world::lanes::{self, Column, Column3, Index8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSource};
+pub(crate) use crate::render::world::materials::lanes::{LaneSurfaces, MaterialTable, Scattered};
 use crate::render::world::{ShapeRef, World};
-use crate::scene::{MaterialModel, Rgb};
-
-/// The `Bsdf` each shape's lanes run, as a float to compare eight at a
-/// time.
-const LAMBERT: f32 = 0.0;
-const MIRROR: f32 = 1.0;
-const GLASS: f32 = 2.0;
-const EMITTER: f32 = 3.0;
-const PHONG: f32 = 4.0;
-const BLINN_PHONG: f32 = 5.0;
-
-/// What shading needs of a shape's material.
-#[derive(Clone, Copy, Debug)]
-struct Surface {
-    object: u32,
-    /// `LAMBERT`, `MIRROR`, `GLASS`, `EMITTER`, `PHONG` or `BLINN_PHONG`.
-    kind: f32,
-    /// Albedo, tint, radiance or a glossy surface's diffuse part.
-    color: Rgb,
-    ior: f32,
-    /// A glossy surface's lobe: its colour, exponent, the chance of
-    /// sampling the diffuse part and Blinn–Phong's normalisation.
-    specular: Rgb,
-    exponent: f32,
-    diffuse_probability: f32,
-    normalisation: f32,
-}
+use crate::scene::Rgb;
 
 /// One sphere, as the hit loop meets it.
 #[derive(Clone, Copy, Debug)]
@@ -167,8 +136,8 @@ pub struct PathLanes {
     /// Each triangle's light plane (`World::light_plane`): a shadow ray
     /// toward a light on a triangle skips the triangles of its plane.
     triangle_planes: Vec<u32>,
-    /// Spheres, then planes, then triangles: what shading needs of each.
-    surfaces: SurfaceTable,
+    /// Spheres, then planes, then triangles: each one's material.
+    surfaces: MaterialTable,
     /// Shadow rays test these always, and the walls only for paths not
     /// inside every wall (see `occluders::Walls`).
     others: Vec<Occluder>,
@@ -194,43 +163,12 @@ impl PathLanes {
         if !lanes::supported() {
             return None;
         }
-        let surface = |object: u32| {
-            let material = &world.materials[world.objects[object as usize].material as usize];
-            let plain = |kind, color, ior| Surface {
-                object,
-                kind,
-                color,
-                ior,
-                specular: Rgb::ZERO,
-                exponent: 0.0,
-                diffuse_probability: 1.0,
-                normalisation: 0.0,
-            };
-            let glossy = |kind, kd, ks, exponent, normalisation| Surface {
-                specular: ks,
-                exponent,
-                diffuse_probability: Bsdf::diffuse_probability(kd, ks),
-                normalisation,
-                ..plain(kind, kd, 1.0)
-            };
-            match (Bsdf::new(material), material) {
-                (Bsdf::Lambert { albedo }, _) => plain(LAMBERT, albedo, 1.0),
-                (Bsdf::Mirror { tint }, _) => plain(MIRROR, tint, 1.0),
-                (Bsdf::Glass { ior, tint }, _) => plain(GLASS, tint, ior),
-                (Bsdf::Phong { kd, ks, exponent }, _) => glossy(PHONG, kd, ks, exponent, 0.0),
-                (Bsdf::BlinnPhong { kd, ks, exponent }, _) => {
-                    glossy(BLINN_PHONG, kd, ks, exponent, blinn_normalisation(exponent))
-                }
-                (Bsdf::Black, MaterialModel::Emissive { radiance }) => plain(EMITTER, *radiance, 1.0),
-                // Reflects nothing, emits nothing: an emitter gone dark
-                (Bsdf::Black, _) => plain(EMITTER, Rgb::ZERO, 1.0),
-            }
-        };
         let s = &world.spheres;
         let objects = s.object.iter().copied();
         let objects = objects.chain(world.planes.iter().map(|p| p.object));
-        let surfaces = objects.chain(world.triangles.iter().map(|(_, object)| *object)).map(surface);
-        let surfaces: Vec<_> = surfaces.collect();
+        let objects = objects.chain(world.triangles.iter().map(|(_, object)| *object));
+        let surfaces =
+            MaterialTable::new(objects, |object| &world.materials[world.objects[object as usize].material as usize]);
         if surfaces.is_empty() {
             return None;
         }
@@ -289,7 +227,7 @@ impl PathLanes {
             triangles: world.triangles.iter().map(|(triangle, _)| *triangle).collect(),
             triangle_culls: lane_culls(&world.triangles),
             triangle_planes: world.light_plane.clone(),
-            surfaces: SurfaceTable::new(surfaces),
+            surfaces,
             lights: LaneLights::new(world),
             light_spheres,
             light_planes,

@@ -90,7 +90,7 @@ pub fn specular_targets(world: &World) -> Vec<(Vec3, f32)> {
     world
         .objects
         .iter()
-        .filter(|o| crate::render::world::bsdf::Bsdf::new(&world.materials[o.material as usize]).is_specular())
+        .filter(|o| crate::render::world::materials::Bsdf::new(&world.materials[o.material as usize]).is_specular())
         .filter(|o| !matches!(world.materials[o.material as usize], crate::scene::MaterialModel::Emissive { .. }))
         .filter_map(|o| match o.shape {
             ShapeRef::Sphere(i) => Some((world.spheres.center(i as usize), world.spheres.radius[i as usize])),

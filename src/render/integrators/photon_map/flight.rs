@@ -11,7 +11,7 @@ use super::emit::{emit, emit_toward, specular_targets, EmittedPhoton, LightPicke
 use super::record::Photon;
 use crate::faults::{self, Fault};
 use crate::geometry::Ray;
-use crate::render::world::bsdf::{Bsdf, Transport};
+use crate::render::world::materials::{Bsdf, Transport};
 use crate::render::world::rng::{PassStreams, Sampler};
 use crate::render::world::{Hit, World};
 use crate::scene::Rgb;

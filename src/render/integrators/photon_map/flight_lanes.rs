@@ -14,8 +14,8 @@ use super::flight::{MapKind, Tracing};
 use super::record::Photon;
 use crate::geometry::offset_origin;
 use crate::render::integrators::path_lanes::{PathLanes, Scattered};
-use crate::render::world::bsdf::Transport;
 use crate::render::world::lanes::{Count8, Rng8, F8, LANES, M8, V8};
+use crate::render::world::materials::Transport;
 
 /// Eight photons between their bounces (`Flight`).
 struct PhotonLanes {

@@ -8,7 +8,7 @@ use glam::Vec3;
 use crate::render::integrators::path_lanes::PathLanes;
 use crate::render::integrators::photon_map::kdtree::{Neighbours, PhotonKdTree};
 use crate::render::integrators::photon_map::trace::{trace_photons_until, MapKind, PhotonBatch};
-use crate::render::world::bsdf::Bsdf;
+use crate::render::world::materials::Bsdf;
 use crate::render::world::World;
 use crate::render::PhotonSettings;
 use crate::scene::Rgb;
@@ -219,7 +219,7 @@ mod tests {
         let photons = (1..=20).map(|d| Photon::new(Vec3::new(d as f32, 0.0, 0.0), -Vec3::Y, [2.0; 3])).collect();
         let tree = PhotonKdTree::build(photons);
         let albedo = 0.6;
-        let bsdf = Bsdf::Lambert { albedo: Rgb::splat(albedo) };
+        let bsdf = Bsdf::lambert(Rgb::splat(albedo));
         let (mut neighbours, mut stats) = (Neighbours::new(8), QueryStats::default());
         let mut gather = |k, max_radius, stats: &mut QueryStats| {
             let value = estimate(&tree, Vec3::ZERO, Vec3::Y, Vec3::Y, &bsdf, k, max_radius, &mut neighbours, stats);

@@ -80,12 +80,13 @@ fn trace(
     let material = world.material_of(&hit);
     let mut local = Rgb::ZERO;
     if shades(material) {
-        let (n, wo) = shading::facing(ray, &hit);
+        let at = shading::at(ray, &hit);
+        let n = at.facing.into();
         // The background is seen by rays that escape, not as a local light
         for light in world.lights.iter().filter(|l| !matches!(l, LightSource::Background { .. })) {
             let lit = |sample: &_| lit_cosine(n, sample);
             if let Some((sample, cos)) = scope.light_sample(light, &hit, sampler.next_2d(), counters, lit) {
-                local += light_term(material, n, wo, &sample, cos);
+                local += light_term(material, &at, &sample, cos);
             }
         }
     }
@@ -96,5 +97,5 @@ fn trace(
     };
     let reflected = follow(branches.reflected);
     let refracted = follow(branches.refracted);
-    combine(world, ray, &hit, depth_left, local, [reflected, refracted], &branches)
+    combine(world, ray, &hit, local, [reflected, refracted], &branches)
 }

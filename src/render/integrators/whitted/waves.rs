@@ -126,7 +126,8 @@ pub fn render_tile(
             if !shades(material) {
                 continue;
             }
-            let (normal, wo) = super::shading::facing(&n.ray, &hit);
+            let at = super::shading::at(&n.ray, &hit);
+            let normal = at.facing.into();
             let (scope, sampler) = (&scopes[root], &mut samplers[root]);
             let first = terms.len() as u32;
             for light in world.lights.iter().filter(|l| !matches!(l, LightSource::Background { .. })) {
@@ -135,7 +136,7 @@ pub fn render_tile(
                     scope.unshadowed_light_sample(light, &hit, sampler.next_2d(), counters, lit)
                 {
                     let shadow = shadows.push(Shadow::toward(&sample, scope.held));
-                    terms.push(Term { value: light_term(material, normal, wo, &sample, cos), shadow });
+                    terms.push(Term { value: light_term(material, &at, &sample, cos), shadow });
                 }
             }
             nodes[node as usize].terms = (first, terms.len() as u32 - first);
@@ -160,7 +161,7 @@ fn radiance(world: &World, nodes: &[Node], terms: &[Term], shadows: &ShadowBatch
     }
     let follow = |child: Option<u32>| child.map_or(Rgb::ZERO, |child| radiance(world, nodes, terms, shadows, child));
     let (reflected, refracted) = (follow(n.children[0]), follow(n.children[1]));
-    combine(world, &n.ray, &hit, n.depth_left, local, [reflected, refracted], &n.branches)
+    combine(world, &n.ray, &hit, local, [reflected, refracted], &n.branches)
 }
 
 #[cfg(test)]
