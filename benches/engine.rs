@@ -109,10 +109,10 @@ fn sppm_caustics(c: &mut Criterion) {
 /// triangles), the Cornell box and smallpt: toward a sample of each light
 /// and between the path's vertices, as the bidirectional methods trace
 /// them. One at a time (`World::blocked`) and eight at a time
-/// (`PathLanes::shadows_blocked`).
+/// (`LaneWorld::shadows_blocked`).
 fn shadow_rays(c: &mut Criterion) {
-    use gi_studio::render::integrators::path_lanes::PathLanes;
     use gi_studio::render::world::camera::{CameraModel, CameraTile, TileRect};
+    use gi_studio::render::world::lane_world::LaneWorld;
     use gi_studio::render::world::occluders::Shadow;
     use gi_studio::render::world::rng::PassStreams;
     use gi_studio::render::world::World;
@@ -121,7 +121,7 @@ fn shadow_rays(c: &mut Criterion) {
         let scene = presets::preset(name).and_then(Result::ok).expect("a preset");
         let camera = CameraModel::new(&scene.camera, 64, 48);
         let (world, _) = World::for_view(&scene, &camera, 64, 48);
-        let lanes = PathLanes::new(&world).expect("a world the lanes trace");
+        let lanes = LaneWorld::new(&world).expect("a world the lanes trace");
         let rect = TileRect { x: 0, y: 0, width: 64, height: 48 };
         let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(0, 9) };
         let mut s = Sampler::new(0, 0, 9);

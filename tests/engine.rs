@@ -9,10 +9,10 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use gi_studio::render::film::Film;
-use gi_studio::render::integrators::path_lanes::PathLanes;
 use gi_studio::render::integrators::photon_map::trace::{trace_photons_until, MapKind, PhotonBatch, CHUNK};
 use gi_studio::render::integrators::{Integrator, PassObserver, Stage};
 use gi_studio::render::world::camera::{CameraModel, TileRect};
+use gi_studio::render::world::lane_world::LaneWorld;
 use gi_studio::render::world::World;
 
 use gi_studio::render::{
@@ -283,7 +283,7 @@ fn a_cancel_waits_for_at_most_one_tile_or_chunk_a_worker() {
         settings.set_photons(20_000);
         let camera = CameraModel::new(&job.scene.camera, settings.width, settings.height);
         let (world, visible) = World::for_view(&job.scene, &camera, settings.width, settings.height);
-        let lanes = PathLanes::new(&world);
+        let lanes = LaneWorld::new(&world);
         let stage = Stage { world: &world, camera: &camera, settings: &settings, lanes: lanes.as_ref() };
         let mut film = Film::new(settings.width, settings.height, settings.tile_size, false);
         let keep = Abandoning::new(usize::MAX);
@@ -309,7 +309,7 @@ fn a_cancel_waits_for_at_most_one_tile_or_chunk_a_worker() {
     let count = 100 * CHUNK;
     let asked = std::sync::atomic::AtomicUsize::new(0);
     let mut photons = Vec::new();
-    let lanes = PathLanes::new(&world);
+    let lanes = LaneWorld::new(&world);
     let batch = PhotonBatch { kind: MapKind::Global, count, pass: 0, seed: 1, max_depth: 8 };
     let all = trace_photons_until(
         &world,

@@ -2,12 +2,12 @@
 //! samples give the same radiance, bit for bit, whatever the lane a path
 //! lands in and however long its neighbours live.
 
-use gi_studio::render::integrators::path;
-use gi_studio::render::integrators::path_lanes::PathLanes;
 use gi_studio::render::integrators::Counters;
+use gi_studio::render::integrators::{path, path_lanes};
 use gi_studio::render::world::camera::CameraModel;
 use gi_studio::render::world::camera::CameraTile;
 use gi_studio::render::world::camera::TileRect;
+use gi_studio::render::world::lane_world::LaneWorld;
 use gi_studio::render::world::rng::PassStreams;
 use gi_studio::render::world::World;
 use gi_studio::scene::{presets, Attenuation, Light, LightKind, MaterialModel, Object, Rgb, Scene, Shape, ValidScene};
@@ -35,7 +35,7 @@ fn world(scene: &Scene, width: u32, height: u32) -> (World, CameraModel) {
 fn assert_lanes_match_scalar(scene: &Scene, max_depth: u32, passes: u64) -> usize {
     let (width, height) = (40, 30);
     let (world, camera) = world(scene, width, height);
-    let lanes = PathLanes::new(&world).expect("a scene the lanes trace");
+    let lanes = LaneWorld::new(&world).expect("a scene the lanes trace");
     let whole = TileRect { x: 0, y: 0, width, height };
     // 13 × 7: rows that do not split into eights, away from the origin
     let ragged = TileRect { x: 21, y: 17, width: 13, height: 7 };
@@ -52,7 +52,7 @@ fn assert_lanes_match_scalar(scene: &Scene, max_depth: u32, passes: u64) -> usiz
                 .collect();
             let mut got = vec![Rgb::splat(-1.0); tile.len()];
             let mut lane_counters = Counters::default();
-            lanes.radiance(&world, &tile, max_depth, &mut |i, v| got[i] = v, &mut lane_counters);
+            path_lanes::radiance(&lanes, &world, &tile, max_depth, &mut |i, v| got[i] = v, &mut lane_counters);
             for (i, (e, g)) in expected.iter().zip(&got).enumerate() {
                 let bits = |v: &Rgb| v.to_array().map(f32::to_bits);
                 assert_eq!(bits(e), bits(g), "sample {i} of {rect:?}, pass {pass}: scalar {e} vs lanes {g}");
@@ -254,7 +254,7 @@ fn glossy_lobes_and_skies_bit_for_bit() {
 #[test]
 fn the_lanes_under_test_are_the_eight_lane_tracer() {
     assert!(
-        PathLanes::runs_in_lanes(),
+        LaneWorld::runs_in_lanes(),
         "this CPU lacks AVX2: the lane tests would compare the scalar tracer with itself"
     );
 }
@@ -305,7 +305,7 @@ fn shadow_rays_in_lanes_are_blocked_as_one_at_a_time() {
     scenes.push(("gap-room with a panel".into(), lamps));
     for (name, scene) in &scenes {
         let (world, camera) = world(scene, 64, 48);
-        let lanes = PathLanes::new(&world).expect("a scene the lanes trace");
+        let lanes = LaneWorld::new(&world).expect("a scene the lanes trace");
         let mut s = Sampler::new(0, 0, 9);
         let mut shadows = Vec::new();
         // Straight through each light triangle to beyond it: only what it

@@ -15,11 +15,11 @@ use super::workers::{Share, Workers};
 use crate::faults::{self, Fault};
 use crate::render::film::Film;
 use crate::render::integrators::bidir::strategies::StrategyImages;
-use crate::render::integrators::path_lanes::PathLanes;
 use crate::render::integrators::photon_map::PhotonMaps;
 use crate::render::integrators::{Integrator, PassObserver, Stage};
 use crate::render::settings::RenderSettings;
 use crate::render::world::camera::{CameraModel, TileRect};
+use crate::render::world::lane_world::LaneWorld;
 use crate::render::world::World;
 use crate::scene::ValidScene;
 
@@ -185,7 +185,7 @@ pub(super) fn run_job(workers: &Workers, context: &JobContext, job: &RenderJob) 
     // The world for eight rays at a time, compiled once for every pass
     let ((mut film, lanes), took) = workers.run_in_turn(&mut share, || {
         assert!(!faults::active(Fault::RenderPanics), "an injected bug");
-        (Film::new(settings.width, settings.height, settings.tile_size, halves), PathLanes::new(&world))
+        (Film::new(settings.width, settings.height, settings.tile_size, halves), LaneWorld::new(&world))
     });
     busy += took;
     let stage = Stage { world: &world, camera: &camera, settings, lanes: lanes.as_ref() };

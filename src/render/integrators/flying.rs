@@ -1,6 +1,6 @@
 //! Items that fly from hit to hit on their own (photons, light and camera
 //! subpaths), eight at a time: their rays meet the world in the paths'
-//! eight-lane hit loop (`PathLanes::lane_hits`), and each goes on from its
+//! eight-lane hit loop (`LaneWorld::lane_hits`), and each goes on from its
 //! hit by itself, in scalar code. A lane whose item ends takes the next
 //! one, so the lanes stay busy however far items go; items end out of
 //! turn, so what they make is tagged with their place for `reorder`.
@@ -10,9 +10,9 @@
 
 use std::ops::Range;
 
-use super::path_lanes::{Given, PathLanes, Want};
 use crate::geometry::Ray;
 use crate::render::world::camera::CameraModel;
+use crate::render::world::lane_world::{Given, LaneWorld, Want};
 use crate::render::world::lanes::{self, LANES};
 use crate::render::world::{Hit, World};
 
@@ -22,11 +22,11 @@ use crate::render::world::{Hit, World};
 /// `bounce` carries it on from the nearest hit (false: it ends there), told
 /// the item's place in `indices`; told None where the ray meets nothing,
 /// which ends the item whatever it says.
-/// Eight at a time through `path_lanes` where given and the CPU has AVX2;
+/// Eight at a time through the `LaneWorld` where given and the CPU has AVX2;
 /// one at a time otherwise, with the same calls for each item in the same
 /// order.
 pub fn fly<T>(
-    path_lanes: Option<&PathLanes>,
+    lane_world: Option<&LaneWorld>,
     world: &World,
     indices: Range<u64>,
     launch: impl FnMut(u64) -> Option<T>,
@@ -34,10 +34,10 @@ pub fn fly<T>(
     mut bounce: impl FnMut(u32, &mut T, Option<&Hit>) -> bool,
 ) {
     let bounce = move |place, item: &mut T, hit: Option<&Hit>, _: Option<&Given>| bounce(place, item, hit);
-    fly_drawing(path_lanes, world, indices, launch, ray, NoDraws, bounce)
+    fly_drawing(lane_world, world, indices, launch, ray, NoDraws, bounce)
 }
 
-/// What items draw at their hits in the lanes (`PathLanes::draw_at_hits`),
+/// What items draw at their hits in the lanes (`LaneWorld::draw_at_hits`),
 /// handed to their `bounce`; one at a time they draw alone, in `bounce`.
 pub(crate) trait DrawAtHits<T> {
     /// What `item` asks to draw at its next hit (None: nothing), asked
@@ -66,7 +66,7 @@ impl<T> DrawAtHits<T> for NoDraws {
 /// `fly`, with what `draws` asks for drawn in the lanes and handed to
 /// `bounce` (None: the item draws alone).
 pub(crate) fn fly_drawing<T>(
-    path_lanes: Option<&PathLanes>,
+    lane_world: Option<&LaneWorld>,
     world: &World,
     indices: Range<u64>,
     launch: impl FnMut(u64) -> Option<T>,
@@ -74,15 +74,15 @@ pub(crate) fn fly_drawing<T>(
     draws: impl DrawAtHits<T>,
     bounce: impl FnMut(u32, &mut T, Option<&Hit>, Option<&Given>) -> bool,
 ) {
-    let Some(path_lanes) = path_lanes else {
+    let Some(lane_world) = lane_world else {
         return fly_one_at_a_time(world, indices, launch, ray, bounce);
     };
     #[cfg(target_arch = "x86_64")]
-    // SAFETY: the CPU has AVX2: a `PathLanes` is made only where it does.
+    // SAFETY: the CPU has AVX2: a `LaneWorld` is made only where it does.
     #[allow(unsafe_code)]
-    return unsafe { fly_avx2(path_lanes, world, indices, launch, ray, draws, bounce) };
+    return unsafe { fly_avx2(lane_world, world, indices, launch, ray, draws, bounce) };
     #[cfg(not(target_arch = "x86_64"))]
-    fly_lanes(path_lanes, world, indices, launch, ray, draws, bounce)
+    fly_lanes(lane_world, world, indices, launch, ray, draws, bounce)
 }
 
 fn fly_one_at_a_time<T>(
@@ -108,7 +108,7 @@ fn fly_one_at_a_time<T>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn fly_avx2<T>(
-    path_lanes: &PathLanes,
+    lane_world: &LaneWorld,
     world: &World,
     indices: Range<u64>,
     launch: impl FnMut(u64) -> Option<T>,
@@ -116,12 +116,12 @@ fn fly_avx2<T>(
     draws: impl DrawAtHits<T>,
     bounce: impl FnMut(u32, &mut T, Option<&Hit>, Option<&Given>) -> bool,
 ) {
-    fly_lanes(path_lanes, world, indices, launch, ray, draws, bounce)
+    fly_lanes(lane_world, world, indices, launch, ray, draws, bounce)
 }
 
 #[inline(always)]
 fn fly_lanes<T>(
-    path_lanes: &PathLanes,
+    lane_world: &LaneWorld,
     world: &World,
     indices: Range<u64>,
     mut launch: impl FnMut(u64) -> Option<T>,
@@ -144,13 +144,13 @@ fn fly_lanes<T>(
         }
         let rays = lanes::each(|i| flying[i].as_ref().map(|(_, item)| ray(item)));
         let wants = lanes::each(|i| flying[i].as_ref().and_then(|(_, item)| draws.want(item)));
-        let (lane_hits, direction) = path_lanes.lane_hits(&rays);
+        let (lane_hits, direction) = lane_world.lane_hits(&rays);
         let drawn = wants.iter().any(Option::is_some);
         if drawn {
             let pick = |u| draws.pick(u);
-            path_lanes.draw_at_hits(world, &lane_hits, direction, &wants, &pick, draws.camera(), &mut given);
+            lane_world.draw_at_hits(world, &lane_hits, direction, &wants, &pick, draws.camera(), &mut given);
         }
-        let hits = path_lanes.hits_of(world, &lane_hits);
+        let hits = lane_world.hits_of(world, &lane_hits);
         for ((slot, hit), given) in flying.iter_mut().zip(&hits).zip(&given) {
             let Some((place, item)) = slot else { continue };
             let given = given.as_ref().filter(|_| drawn);

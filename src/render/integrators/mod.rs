@@ -4,7 +4,7 @@
 //! looks like now. Here the dispatch; in `vocabulary` what every pass
 //! reads, counts and reports. What they share is written once: next-event
 //! estimation (`next_event`), BSDFs, occlusion and the lanes (`world`,
-//! `path_lanes`, compiled once per job and read through `Stage::lanes`).
+//! `world::lane_world`, compiled once per job and read through `Stage::lanes`).
 
 pub mod bidir;
 pub mod flying;

@@ -3,7 +3,7 @@
 //! sampling for area lights, Russian roulette.
 
 use super::next_event::PathScope;
-use super::Stage;
+use super::{path_lanes, Stage};
 use super::{Counters, ROULETTE_DEPTH};
 use crate::faults::{self, Fault};
 use crate::geometry::Ray;
@@ -31,7 +31,7 @@ impl PathTracer {
     }
 
     /// One sample of every pixel of `tile`, each handed to `out` with its
-    /// index as it is done (`PathLanes::radiance`).
+    /// index as it is done (`LaneWorld::radiance`).
     pub fn render_tile(
         &self,
         stage: &Stage,
@@ -40,7 +40,7 @@ impl PathTracer {
         counters: &mut Counters,
     ) {
         if let Some(lanes) = stage.lanes {
-            return lanes.radiance(stage.world, tile, self.max_depth, out, counters);
+            return path_lanes::radiance(lanes, stage.world, tile, self.max_depth, out, counters);
         }
         for i in 0..tile.len() {
             let (ray, mut sampler) = tile.sample(i);
@@ -129,9 +129,9 @@ pub fn radiance(world: &World, ray: &Ray, max_depth: u32, sampler: &mut Sampler,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::integrators::path_lanes::PathLanes;
     use crate::render::settings::RenderSettings;
     use crate::render::world::camera::{CameraModel, TileRect};
+    use crate::render::world::lane_world::LaneWorld;
     use crate::render::world::rng::PassStreams;
 
     /// A tile rendered through the lanes and one at a time (what a CPU
@@ -145,7 +145,7 @@ mod tests {
         let (world, _) = World::for_view(&scene, &camera, 24, 18);
         let rect = TileRect { x: 0, y: 0, width: 24, height: 18 };
         let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(0, 3) };
-        let lanes = PathLanes::new(&world).expect("spheres only, on a CPU with AVX2");
+        let lanes = LaneWorld::new(&world).expect("spheres only, on a CPU with AVX2");
         let settings = RenderSettings::default();
         let tracer = PathTracer::new(32);
         let mut rendered = Vec::new();

@@ -268,10 +268,10 @@ impl PhotonRenderer<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::integrators::path_lanes::PathLanes;
     use crate::render::integrators::photon_map::maps::resolve_max_radius;
     use crate::render::settings::RenderSettings;
     use crate::render::world::camera::{CameraModel, TileRect};
+    use crate::render::world::lane_world::LaneWorld;
     use crate::render::world::rng::PassStreams;
     use crate::scene::presets;
 
@@ -295,7 +295,7 @@ mod tests {
                     final_gather_rays: 3,
                     ..PhotonSettings::default()
                 };
-                let compiled = PathLanes::new(&world);
+                let compiled = LaneWorld::new(&world);
                 let maps = PhotonMaps::build_until(&world, compiled.as_ref(), &settings, 3, 8, &|| true).expect("maps");
                 let max_radius = resolve_max_radius(visible_radius, &settings);
                 let photon = PhotonMapping::new(Arc::new(maps), &settings, 8, max_radius);

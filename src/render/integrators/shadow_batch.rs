@@ -1,9 +1,9 @@
 //! Shadow rays asked for as a path goes and traced later, all at once and
-//! eight at a time (`PathLanes::shadows_blocked`). A caller keeps what each
+//! eight at a time (`LaneWorld::shadows_blocked`). A caller keeps what each
 //! would let through and adds it, in the order it was found, once the batch
 //! says what is blocked: the same sums as tracing each ray at once.
 
-use super::path_lanes::PathLanes;
+use crate::render::world::lane_world::LaneWorld;
 use crate::render::world::occluders::Shadow;
 use crate::render::world::World;
 
@@ -36,7 +36,7 @@ impl ShadowBatch {
 
     /// Trace every ray asked for since `clear`: through `lanes` where given,
     /// else one at a time.
-    pub fn trace(&mut self, lanes: Option<&PathLanes>, world: &World) {
+    pub fn trace(&mut self, lanes: Option<&LaneWorld>, world: &World) {
         self.blocked.clear();
         self.blocked.resize(self.shadows.len(), false);
         match lanes {

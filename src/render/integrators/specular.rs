@@ -8,10 +8,10 @@
 use glam::Vec3;
 
 use super::next_event::PathScope;
-use super::path_lanes::PathLanes;
 use super::{flying, Counters};
 use crate::geometry::Ray;
 use crate::render::world::camera::CameraTile;
+use crate::render::world::lane_world::LaneWorld;
 use crate::render::world::materials::{Bsdf, Transport};
 use crate::render::world::rng::Sampler;
 use crate::render::world::{Hit, World};
@@ -126,7 +126,7 @@ struct CameraChain<'w> {
 /// the samples.
 pub fn follow_specular_tile(
     world: &World,
-    lanes: Option<&PathLanes>,
+    lanes: Option<&LaneWorld>,
     tile: &CameraTile,
     max_depth: u32,
     counters: &mut Counters,

@@ -14,7 +14,6 @@ use rayon::prelude::*;
 
 use super::next_event::lit_sum;
 use super::next_event::PathScope;
-use super::path_lanes::PathLanes;
 use super::photon_map::grid::PhotonGrid;
 use super::photon_map::trace::{trace_photons_until, MapKind, PhotonBatch};
 use super::photon_map::Photon;
@@ -26,6 +25,7 @@ use crate::geometry::Ray;
 use crate::render::film::Film;
 use crate::render::settings::{RenderSettings, SppmSettings};
 use crate::render::world::camera::CameraTile;
+use crate::render::world::lane_world::LaneWorld;
 use crate::render::world::materials::Bsdf;
 use crate::render::world::rng::Sampler;
 use crate::render::world::World;
@@ -264,7 +264,7 @@ pub fn camera_pass(
 /// point's direct light traced together; the same light bit for bit.
 pub fn eye_pass(
     world: &World,
-    lanes: Option<&PathLanes>,
+    lanes: Option<&LaneWorld>,
     tile: &CameraTile,
     max_depth: u32,
     counters: &mut Counters,
@@ -312,7 +312,7 @@ mod tests {
             let (width, height) = (40, 30);
             let camera = CameraModel::new(&scene.camera, width, height);
             let (world, _) = World::for_view(&scene, &camera, width, height);
-            let lanes = PathLanes::new(&world);
+            let lanes = LaneWorld::new(&world);
             let rect = TileRect { x: 3, y: 2, width: 29, height: 11 };
             let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(1, 4) };
             for max_depth in [1, 2, 8] {

@@ -5,11 +5,11 @@
 use std::time::Duration;
 
 use super::bidir;
-use super::path_lanes::PathLanes;
 use super::photon_map::QueryStats;
 use crate::render::film::TermSums;
 use crate::render::settings::RenderSettings;
 use crate::render::world::camera::{CameraModel, TileRect};
+use crate::render::world::lane_world::LaneWorld;
 use crate::render::world::rng::PassStreams;
 use crate::render::world::World;
 use crate::scene::Rgb;
@@ -108,7 +108,7 @@ pub struct Stage<'a> {
     pub settings: &'a RenderSettings,
     /// The world compiled for eight rays at a time, where the CPU and the
     /// world allow: every algorithm traces through it.
-    pub lanes: Option<&'a PathLanes>,
+    pub lanes: Option<&'a LaneWorld>,
 }
 
 impl Stage<'_> {

@@ -4,6 +4,7 @@
 
 pub mod camera;
 pub mod emission;
+pub mod lane_world;
 pub(crate) mod lanes;
 pub mod light;
 pub mod materials;

@@ -23,10 +23,10 @@ use super::Context;
 use crate::geometry::Ray;
 use crate::render::integrators::flying::{self, DrawAtHits};
 use crate::render::integrators::next_event::PathScope;
-use crate::render::integrators::path_lanes::{Given, PickedLight, Want};
 use crate::render::integrators::shadow_batch::ShadowBatch;
 use crate::render::integrators::{reorder, Counters};
 use crate::render::world::camera::CameraTile;
+use crate::render::world::lane_world::{Given, PickedLight, Want};
 use crate::render::world::light::LightSource;
 use crate::render::world::materials::{Bsdf, Transport};
 use crate::render::world::occluders::Shadow;
@@ -216,7 +216,7 @@ pub fn trace(
     let mut ended = Ended { paths: Vec::new(), shadows: ShadowBatch::default() };
     // The ended paths' shadow rays traced, their light into `out`
     let mut finish = |ended: &mut Ended, contributions: &mut Vec<Contribution>| {
-        ended.shadows.trace(ctx.path_lanes, ctx.world);
+        ended.shadows.trace(ctx.lane_world, ctx.world);
         for EndedPath { place, small_pixel, mut found, first } in ended.paths.drain(..) {
             out[place as usize] = match ctx.strategy_film {
                 Some(_) => found.sum(&ended.shadows, first, &mut PixelTally { pixel: small_pixel, out: contributions }),
@@ -240,7 +240,7 @@ pub fn trace(
         false
     };
     let draws = CameraDraws { ctx };
-    flying::fly_drawing(ctx.path_lanes, ctx.world, 0..count as u64, launch, ray, draws, bounce);
+    flying::fly_drawing(ctx.lane_world, ctx.world, 0..count as u64, launch, ray, draws, bounce);
     finish(&mut ended, contributions);
     counters.rays += rays;
     if !places.is_empty() {
@@ -409,7 +409,7 @@ fn background_weight(
 }
 
 /// A light chosen by power for next-event estimation at `hit`, and a
-/// sample of it: as `PathLanes::draw_at_hits` draws it in the lanes.
+/// sample of it: as `LaneWorld::draw_at_hits` draws it in the lanes.
 fn draw_light(ctx: &Context, hit: &Hit, sampler: &mut Sampler) -> Option<PickedLight> {
     let (index, pick) = ctx.picker.pick(sampler.next_f32())?;
     Some((index, pick, ctx.world.lights[index].sample(&hit.surface, sampler.next_2d())))
@@ -550,10 +550,10 @@ mod tests {
     use crate::render::integrators::bidir::light_paths;
     use crate::render::integrators::bidir::mis::Strategies;
     use crate::render::integrators::bidir::strategies::StrategyFilm;
-    use crate::render::integrators::path_lanes::PathLanes;
     use crate::render::integrators::photon_map::emit::LightPicker;
     use crate::render::settings::MisHeuristic;
     use crate::render::world::camera::{CameraModel, TileRect};
+    use crate::render::world::lane_world::LaneWorld;
     use crate::render::world::rng::PassStreams;
     use crate::render::world::World;
     use crate::scene::presets;
@@ -565,21 +565,21 @@ mod tests {
     /// the same pixels, contributions and counts, bit for bit.
     #[test]
     fn eight_at_a_time_make_what_one_at_a_time_make() {
-        assert!(PathLanes::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
+        assert!(LaneWorld::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
         let (width, height) = (40, 30);
         let film = StrategyFilm::new(width, height);
         for name in presets::names() {
             let scene = presets::preset(name).and_then(Result::ok).expect("preset");
             let camera = CameraModel::new(&scene.camera, width, height);
             let (world, visible_radius) = World::for_view(&scene, &camera, width, height);
-            let path_lanes = PathLanes::new(&world).expect("a world the lanes trace");
+            let lane_world = LaneWorld::new(&world).expect("a world the lanes trace");
             let picker = LightPicker::new(&world);
             let pixels = (width * height) as f32;
             let radius = visible_radius * 0.01;
             for (strategy_film, caustics) in [(None, false), (Some(&film), false), (None, true)] {
                 let lanes_ctx = Context {
                     world: &world,
-                    path_lanes: Some(&path_lanes),
+                    lane_world: Some(&lane_world),
                     camera: &camera,
                     strategies: Strategies::with_merges(MisHeuristic::Power, true, true, caustics, pixels, radius),
                     picker: &picker,
@@ -590,7 +590,7 @@ mod tests {
                     light_tracing: false,
                     strategy_film,
                 };
-                let scalar_ctx = Context { path_lanes: None, ..lanes_ctx };
+                let scalar_ctx = Context { lane_world: None, ..lanes_ctx };
                 let paths = light_paths::trace(&lanes_ctx, pixels as u64, 2, 5, &|| true).expect("not cancelled");
                 let grid = MergeGrid::build(&paths, radius, &lanes_ctx.strategies, Default::default());
                 let light = LightSide { paths: &paths, grid: Some(&grid), radius };

@@ -20,10 +20,10 @@ use crate::geometry::{Ray, SurfaceHit};
 use crate::render::film::Splat;
 use crate::render::integrators::flying::{self, DrawAtHits};
 use crate::render::integrators::next_event::PathScope;
-use crate::render::integrators::path_lanes::{Given, PathLanes, Want};
 use crate::render::integrators::shadow_batch::ShadowBatch;
 use crate::render::integrators::{reorder, Counters};
 use crate::render::world::camera::{CameraConnection, CameraModel};
+use crate::render::world::lane_world::{Given, LaneWorld, Want};
 use crate::render::world::light::LightSource;
 use crate::render::world::materials::{Bsdf, Transport};
 use crate::render::world::occluders::Shadow;
@@ -124,7 +124,7 @@ pub fn trace(
                 return None;
             }
             let indices = chunk as u64 * CHUNK..((chunk as u64 + 1) * CHUNK).min(count);
-            Some(Flights { ctx, pass, seed }.trace(ctx.path_lanes, indices))
+            Some(Flights { ctx, pass, seed }.trace(ctx.lane_world, indices))
         })
         .collect();
     let mut paths =
@@ -187,7 +187,7 @@ impl ChunkPaths {
     /// become splats (and contributions), in the order they were made.
     fn trace_joins(&mut self, ctx: &Context) {
         let joins = &mut self.joins;
-        joins.shadows.trace(ctx.path_lanes, ctx.world);
+        joins.shadows.trace(ctx.lane_world, ctx.world);
         for join in joins.waiting.drain(..) {
             if joins.shadows.blocked(join.shadow) {
                 continue;
@@ -350,9 +350,9 @@ impl<'w> Flights<'_, 'w> {
     }
 
     /// The paths `indices`: what they make, in path order. Eight at a time
-    /// through `path_lanes` where given (and the CPU allows), the same bit
+    /// through the `LaneWorld` where given (and the CPU allows), the same bit
     /// for bit.
-    fn trace(&self, path_lanes: Option<&PathLanes>, indices: Range<u64>) -> ChunkPaths {
+    fn trace(&self, lane_world: Option<&LaneWorld>, indices: Range<u64>) -> ChunkPaths {
         let mut out = ChunkPaths::default();
         // Which path made each vertex, splat and contribution: its place among `indices`
         let mut places = Vec::new();
@@ -377,7 +377,7 @@ impl<'w> Flights<'_, 'w> {
         };
         let count = (indices.end - indices.start) as usize;
         let (world, draws) = (self.ctx.world, LightDraws { ctx: self.ctx });
-        flying::fly_drawing(path_lanes, world, indices, |index| self.launch(index), ray, draws, bounce);
+        flying::fly_drawing(lane_world, world, indices, |index| self.launch(index), ray, draws, bounce);
         out.counters.rays += rays;
         out.trace_joins(self.ctx);
         (out.vertices, out.ends) = reorder::by_item(&out.vertices, &places, count);
@@ -454,7 +454,7 @@ mod tests {
     /// contributions and counts, bit for bit.
     #[test]
     fn eight_at_a_time_make_what_one_at_a_time_make() {
-        assert!(PathLanes::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
+        assert!(LaneWorld::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
         let (width, height) = (48, 36);
         let film = StrategyFilm::new(width, height);
         // Each preset through its pinhole and through a lens, whose
@@ -465,7 +465,7 @@ mod tests {
             let camera = CameraModel::new(&Camera { aperture_radius, ..scene.camera.clone() }, width, height);
             assert_eq!(camera.has_lens(), aperture_radius > 0.0);
             let (world, visible_radius) = World::for_view(&scene, &camera, width, height);
-            let path_lanes = PathLanes::new(&world).expect("a world the lanes trace");
+            let lane_world = LaneWorld::new(&world).expect("a world the lanes trace");
             let picker = LightPicker::new(&world);
             let ways = [(false, false, true), (true, false, false), (false, true, false), (true, true, false)];
             let mut made = 0;
@@ -475,7 +475,7 @@ mod tests {
                     let pixels = (width * height) as f32;
                     let lanes_ctx = Context {
                         world: &world,
-                        path_lanes: Some(&path_lanes),
+                        lane_world: Some(&lane_world),
                         camera: &camera,
                         strategies: Strategies::new(MisHeuristic::Power, connect, merge, pixels, visible_radius * 0.01),
                         picker: &picker,
@@ -487,11 +487,11 @@ mod tests {
                         strategy_film,
                     };
                     // One at a time with shadow rays one at a time too
-                    let scalar_ctx = Context { path_lanes: None, ..lanes_ctx };
+                    let scalar_ctx = Context { lane_world: None, ..lanes_ctx };
                     // Not a multiple of eight, away from 0
                     let indices = 100..1123;
                     let one = Flights { ctx: &scalar_ctx, pass: 3, seed: 11 }.trace(None, indices.clone());
-                    let eight = Flights { ctx: &lanes_ctx, pass: 3, seed: 11 }.trace(Some(&path_lanes), indices);
+                    let eight = Flights { ctx: &lanes_ctx, pass: 3, seed: 11 }.trace(Some(&lane_world), indices);
                     let view = strategy_film.is_some();
                     let what = format!(
                         "{name}, lens {aperture_radius}, connect {connect}, merge {merge}, view {view}, {max_length} segments"

@@ -143,7 +143,7 @@ mod tests {
         let (pixels, radius) = ((width * height) as f32, visible_radius * 0.01);
         let ctx = Context {
             world: &world,
-            path_lanes: None,
+            lane_world: None,
             camera: &camera,
             strategies: Strategies::with_merges(MisHeuristic::Power, true, true, true, pixels, radius),
             picker: &picker,

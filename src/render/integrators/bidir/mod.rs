@@ -23,13 +23,13 @@ pub mod strategies;
 
 use rayon::prelude::*;
 
-use super::path_lanes::PathLanes;
 use super::photon_map::emit::LightPicker;
 use super::{Counters, PassObserver, PassReport, Stage};
 use crate::render::film::{Film, TermSums};
 use crate::render::settings::{Algorithm, Method, MisHeuristic, RenderSettings};
 use crate::render::world::camera::{CameraModel, CameraTile};
 use crate::render::world::emission::Bounds;
+use crate::render::world::lane_world::LaneWorld;
 use crate::render::world::light::LightSource;
 use crate::render::world::World;
 use crate::scene::Rgb;
@@ -82,7 +82,7 @@ pub struct Bidir {
 pub struct Context<'a> {
     pub world: &'a World,
     /// The world for eight rays at a time, where it can be compiled.
-    pub path_lanes: Option<&'a PathLanes>,
+    pub lane_world: Option<&'a LaneWorld>,
     pub camera: &'a CameraModel,
     pub strategies: Strategies,
     pub picker: &'a LightPicker,
@@ -214,7 +214,7 @@ impl Bidir {
         let background = world.lights.iter().position(|l| matches!(l, LightSource::Background { .. }));
         let ctx = Context {
             world,
-            path_lanes: stage.lanes,
+            lane_world: stage.lanes,
             camera: stage.camera,
             strategies: weighing,
             picker: &self.picker,

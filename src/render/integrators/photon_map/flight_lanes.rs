@@ -13,7 +13,7 @@ use glam::Vec3;
 use super::flight::{MapKind, Tracing};
 use super::record::Photon;
 use crate::geometry::offset_origin;
-use crate::render::integrators::path_lanes::{PathLanes, Scattered};
+use crate::render::world::lane_world::{LaneWorld, Scattered};
 use crate::render::world::lanes::{Count8, Rng8, F8, LANES, M8, V8};
 use crate::render::world::materials::Transport;
 
@@ -48,27 +48,27 @@ impl PhotonLanes {
 }
 
 impl Tracing<'_> {
-    /// Photons `indices` through `path_lanes`, each stored photon told to
+    /// Photons `indices` through the `LaneWorld`, each stored photon told to
     /// `store` with its photon's place in `indices`.
-    pub(super) fn fly_in_lanes(&self, path_lanes: &PathLanes, indices: Range<u64>, store: impl FnMut(u32, Photon)) {
+    pub(super) fn fly_in_lanes(&self, lane_world: &LaneWorld, indices: Range<u64>, store: impl FnMut(u32, Photon)) {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the CPU has AVX2: a `PathLanes` is made only where it does.
+        // SAFETY: the CPU has AVX2: a `LaneWorld` is made only where it does.
         #[allow(unsafe_code)]
         unsafe {
-            self.fly_avx2(path_lanes, indices, store)
+            self.fly_avx2(lane_world, indices, store)
         };
         #[cfg(not(target_arch = "x86_64"))]
-        self.fly_lanes(path_lanes, indices, store);
+        self.fly_lanes(lane_world, indices, store);
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn fly_avx2(&self, path_lanes: &PathLanes, indices: Range<u64>, store: impl FnMut(u32, Photon)) {
-        self.fly_lanes(path_lanes, indices, store);
+    fn fly_avx2(&self, lane_world: &LaneWorld, indices: Range<u64>, store: impl FnMut(u32, Photon)) {
+        self.fly_lanes(lane_world, indices, store);
     }
 
     #[inline(always)]
-    fn fly_lanes(&self, path_lanes: &PathLanes, indices: Range<u64>, mut store: impl FnMut(u32, Photon)) {
+    fn fly_lanes(&self, lane_world: &LaneWorld, indices: Range<u64>, mut store: impl FnMut(u32, Photon)) {
         let zero = V8::splat(Vec3::ZERO);
         let mut st = PhotonLanes {
             active: M8::NONE,
@@ -83,20 +83,20 @@ impl Tracing<'_> {
         };
         let mut next = indices.start;
         loop {
-            self.launch_idle(path_lanes, &mut st, &mut next, &indices);
+            self.launch_idle(lane_world, &mut st, &mut next, &indices);
             if !st.active.any() {
                 return;
             }
-            self.bounce_lanes(path_lanes, &mut st, &mut store);
+            self.bounce_lanes(lane_world, &mut st, &mut store);
         }
     }
 
     /// Idle lanes take the next photons, all at once: their streams' first
     /// draws, the light each picks (lane by lane) and where it leaves that
-    /// light (`PathLanes::emit`), as `Tracing::launch` has them. Caustic
+    /// light (`LaneWorld::emit`), as `Tracing::launch` has them. Caustic
     /// photons, which aim at the mirrors and glass, leave one by one.
     #[inline(always)]
-    fn launch_idle(&self, path_lanes: &PathLanes, st: &mut PhotonLanes, next: &mut u64, indices: &Range<u64>) {
+    fn launch_idle(&self, lane_world: &LaneWorld, st: &mut PhotonLanes, next: &mut u64, indices: &Range<u64>) {
         if self.kind() == MapKind::Caustic {
             return self.launch_one_by_one(st, next, indices);
         }
@@ -132,7 +132,7 @@ impl Tracing<'_> {
             }
             let started = M8::from_bits(picked);
             let (u1, u2) = (rng.next_2d(started), rng.next_2d(started));
-            let emitted = path_lanes.emit(self.world(), &light, started, u1, u2);
+            let emitted = lane_world.emit(self.world(), &light, started, u1, u2);
             let power = emitted.power / F8::from_array(probability) * F8::splat(self.power_scale());
             let mut held = 0;
             for lane in started.lanes() {
@@ -174,8 +174,8 @@ impl Tracing<'_> {
     /// `Tracing::bounce` for every photon in flight, at its ray's nearest
     /// hit; photons that end leave their lanes idle.
     #[inline(always)]
-    fn bounce_lanes(&self, path_lanes: &PathLanes, st: &mut PhotonLanes, store: &mut impl FnMut(u32, Photon)) {
-        let (hits, surfaces) = path_lanes.hit_surfaces(st.active, st.held, st.origin, st.direction);
+    fn bounce_lanes(&self, lane_world: &LaneWorld, st: &mut PhotonLanes, store: &mut impl FnMut(u32, Photon)) {
+        let (hits, surfaces) = lane_world.hit_surfaces(st.active, st.held, st.origin, st.direction);
         let found = hits.found;
         // Stored at non-specular hits, by the map's rule, if finite
         let specular = surfaces.specular();

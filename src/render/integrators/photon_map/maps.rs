@@ -5,9 +5,9 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 
-use crate::render::integrators::path_lanes::PathLanes;
 use crate::render::integrators::photon_map::kdtree::{Neighbours, PhotonKdTree};
 use crate::render::integrators::photon_map::trace::{trace_photons_until, MapKind, PhotonBatch};
+use crate::render::world::lane_world::LaneWorld;
 use crate::render::world::materials::Bsdf;
 use crate::render::world::World;
 use crate::render::PhotonSettings;
@@ -83,7 +83,7 @@ pub fn resolve_max_radius(visible_radius: f32, settings: &PhotonSettings) -> f32
 impl PhotonMaps {
     /// Trace both maps, with `seed` and paths of at most `max_depth`.
     pub fn build(world: &World, settings: &PhotonSettings, seed: u64, max_depth: u32) -> Self {
-        let lanes = PathLanes::new(world);
+        let lanes = LaneWorld::new(world);
         let built = Self::build_until(world, lanes.as_ref(), settings, seed, max_depth, &|| true);
         built.expect("a build that is never abandoned")
     }
@@ -93,7 +93,7 @@ impl PhotonMaps {
     /// None once it says no.
     pub fn build_until(
         world: &World,
-        lanes: Option<&PathLanes>,
+        lanes: Option<&LaneWorld>,
         settings: &PhotonSettings,
         seed: u64,
         max_depth: u32,

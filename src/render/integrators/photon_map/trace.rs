@@ -14,8 +14,8 @@ use rayon::prelude::*;
 pub use super::flight::MapKind;
 use super::flight::{Flight, Tracing};
 use super::record::Photon;
-use crate::render::integrators::path_lanes::PathLanes;
 use crate::render::integrators::{flying, reorder};
+use crate::render::world::lane_world::LaneWorld;
 use crate::render::world::{Hit, World};
 
 /// Photons a task traces: the unit of work a cancel waits for at most.
@@ -36,7 +36,7 @@ pub struct PhotonBatch {
 
 /// Trace `batch` through `world` (eight at a time where the lanes run).
 pub fn trace_photons(world: &World, batch: PhotonBatch) -> Vec<Photon> {
-    let (lanes, mut photons) = (PathLanes::new(world), Vec::new());
+    let (lanes, mut photons) = (LaneWorld::new(world), Vec::new());
     trace_photons_until(world, lanes.as_ref(), batch, &|| true, &mut photons);
     photons
 }
@@ -50,7 +50,7 @@ pub fn trace_photons(world: &World, batch: PhotonBatch) -> Vec<Photon> {
 /// Eight at a time through `lanes` where given.
 pub fn trace_photons_until(
     world: &World,
-    lanes: Option<&PathLanes>,
+    lanes: Option<&LaneWorld>,
     batch: PhotonBatch,
     keep_going: &(dyn Fn() -> bool + Sync),
     photons: &mut Vec<Photon>,
@@ -83,14 +83,14 @@ pub fn trace_photons_until(
 }
 
 /// The photons `indices`: what they store, in photon order. Eight at a
-/// time through `path_lanes` where given, with the same records bit for
+/// time through the `LaneWorld` where given, with the same records bit for
 /// bit.
-fn trace_chunk(path_lanes: Option<&PathLanes>, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
+fn trace_chunk(lane_world: Option<&LaneWorld>, tracing: &Tracing, indices: Range<u64>) -> Vec<Photon> {
     // Each stored photon, and its photon's place among `indices`
     let (mut stored, mut places) = (Vec::new(), Vec::new());
     let items = (indices.end - indices.start) as usize;
-    match path_lanes {
-        Some(path_lanes) => tracing.fly_in_lanes(path_lanes, indices, |place, photon| {
+    match lane_world {
+        Some(lane_world) => tracing.fly_in_lanes(lane_world, indices, |place, photon| {
             stored.push(photon);
             places.push(place);
         }),
@@ -131,7 +131,7 @@ mod tests {
         // As a render builds it: walls anchored where the camera looks
         let camera = CameraModel::new(&scene.camera, 64, 48);
         let (world, _) = World::for_view(&scene, &camera, 64, 48);
-        let lanes = PathLanes::new(&world).expect("a world the lanes trace");
+        let lanes = LaneWorld::new(&world).expect("a world the lanes trace");
         let mut stored = 0;
         for kind in [MapKind::Global, MapKind::Caustic, MapKind::Indirect, MapKind::All] {
             for pass in 0..2 {
@@ -151,7 +151,7 @@ mod tests {
 
     #[test]
     fn every_preset_stores_what_one_photon_at_a_time_stores() {
-        assert!(PathLanes::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
+        assert!(LaneWorld::runs_in_lanes(), "this CPU lacks AVX2: the lanes would be the scalar code here");
         for name in presets::names() {
             let stored = assert_lanes_store_what_one_by_one_does(name, preset(name), 16);
             assert!(stored > 1000, "{name}: only {stored} photons stored");

@@ -11,10 +11,10 @@ use super::shading::{branches, combine, light_term, lit_cosine, shades, Branches
 use crate::geometry::Ray;
 use crate::render::integrators::flying;
 use crate::render::integrators::next_event::PathScope;
-use crate::render::integrators::path_lanes::PathLanes;
 use crate::render::integrators::shadow_batch::ShadowBatch;
 use crate::render::integrators::Counters;
 use crate::render::world::camera::CameraTile;
+use crate::render::world::lane_world::LaneWorld;
 use crate::render::world::light::LightSource;
 use crate::render::world::occluders::Shadow;
 use crate::render::world::{Hit, World};
@@ -44,7 +44,7 @@ struct Term {
 /// Every sample of `tile`, rays `max_depth` deep, into `out`.
 pub fn render_tile(
     world: &World,
-    lanes: Option<&PathLanes>,
+    lanes: Option<&LaneWorld>,
     tile: &CameraTile,
     max_depth: u32,
     out: &mut [Rgb],
@@ -191,7 +191,7 @@ mod tests {
             let camera = CameraModel::new(&scene.camera, width, height);
             let valid = ValidScene::new(scene.clone()).expect("valid");
             let (world, _) = World::for_view(&valid, &camera, width, height);
-            let lanes = PathLanes::new(&world);
+            let lanes = LaneWorld::new(&world);
             // Rows that do not split into eights, away from the corner
             let rect = TileRect { x: 5, y: 3, width: 27, height: 13 };
             let tile = CameraTile { camera: &camera, rect, streams: PassStreams::new(3, 7) };

@@ -3,7 +3,7 @@
 //! what is written here, whatever else changes in the function around it.
 //!
 //! The invariant that makes this sound: these values exist only on CPUs
-//! with AVX2. `path_lanes` builds lanes only inside its AVX2 entry point,
+//! with AVX2. `lane_world` builds lanes only inside its AVX2 entry point,
 //! entered after `is_x86_feature_detected!("avx2")`; other CPUs render with
 //! the scalar tracer. The tests that use the lanes directly check the CPU
 //! first, and `lanes` is private to the crate, so nothing outside can

@@ -9,7 +9,7 @@
 use glam::{Vec2, Vec3};
 
 use super::lights::LightLanes;
-use super::{LaneHits, LaneSurfaces, PathLanes, Scattered};
+use super::{LaneHits, LaneSurfaces, LaneWorld, Scattered};
 use crate::geometry::{Ray, SurfaceHit};
 use crate::render::world::camera::{CameraConnection, CameraModel, ConnectionOf};
 use crate::render::world::lanes::{self, Rng8, F8, LANES, M8, V8};
@@ -60,7 +60,7 @@ impl Given {
     }
 }
 
-impl PathLanes {
+impl LaneWorld {
     /// The draws of the lanes that `wants` asks for and that `hits` found on
     /// a surface that is not specular, the rays arriving along `direction`,
     /// into `given` (None in every other lane); `pick` chooses a light from

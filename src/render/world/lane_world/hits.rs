@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use super::{LaneHits, LaneSurfaces, PathLanes};
+use super::{LaneHits, LaneSurfaces, LaneWorld};
 use crate::geometry::sphere::{nearest_root, wall_exit_hit};
 use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_finish_of, watertight_range_of, RayShear};
 use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
@@ -13,7 +13,7 @@ use crate::geometry::{plane_exit_of, plane_point_of, plane_t_of, Crossing, CullE
 use crate::render::world::lanes::{self, Index8, F8, LANES, M8, V8};
 use crate::render::world::{Hit, World};
 
-impl PathLanes {
+impl LaneWorld {
     /// The nearest hits of up to eight rays, each `held` or not as
     /// `World::intersect_held` takes it, still in the lanes (`hits_of`
     /// gives them lane by lane: that function's hits, bit for bit), and the
@@ -67,7 +67,7 @@ impl PathLanes {
     /// The nearest hit of each ray of `active` (`held` those inside every
     /// wall): `World::intersect_held`, eight rays at a time, bit for bit.
     #[inline(always)]
-    pub(super) fn nearest(&self, active: M8, held: M8, origin: V8, direction: V8) -> LaneHits {
+    pub(crate) fn nearest(&self, active: M8, held: M8, origin: V8, direction: V8) -> LaneHits {
         // Spheres in index order, ties keeping the first (`SphereLanes::nearest`):
         // all of them for paths not held, all but the walls for held ones.
         // Usually every path is held: then the walls' near roots are never asked
@@ -426,7 +426,7 @@ mod tests {
                 let near = (!turned_away).and_not(sure);
                 let shear = ray_shear_of(origin, direction);
                 let (hits, t, point, error) =
-                    PathLanes::triangle_hits(triangle, near, origin, direction, &shear, t_max);
+                    LaneWorld::triangle_hits(triangle, near, origin, direction, &shear, t_max);
                 let (sure_point, sure_error) = triangle.cull.plane.hit_point(origin, direction, crossing.t);
                 let (hits, t) = (hits.or(sure), sure.select(crossing.t, t));
                 let (point, error) = (sure.select_v(sure_point, point), sure.select(sure_error, error));

@@ -312,7 +312,7 @@ mod tests {
         scene
     }
 
-    /// Every wall asked in index order, as `PathLanes::nearest` once did.
+    /// Every wall asked in index order, as `LaneWorld::nearest` once did.
     fn every_wall(walls: &[(u32, AnchoredSphere)], held: M8, origin: V8, direction: V8) -> (F8, F8) {
         let (mut t_hit, mut index) = (F8::splat(f32::INFINITY), F8::splat(-1.0));
         for &(shape, sphere) in walls {

@@ -160,7 +160,7 @@ impl LaneLight {
 /// The scene's lights as the lanes sample them, with what every sample
 /// would otherwise look up again.
 #[derive(Clone, Debug)]
-pub(super) struct LaneLights {
+pub(crate) struct LaneLights {
     /// Each light of the world, `None` for those sampled lane by lane.
     lights: Vec<Option<LaneLight>>,
     /// Whether every light is of one kind the lanes draw (then every lane
@@ -195,7 +195,7 @@ impl LaneLights {
     /// and the point does not depend on what it lights (a cap, a triangle):
     /// drawn before the hit is known, its work overlaps the hit's.
     #[inline(always)]
-    pub(super) fn drawn_ahead(&self, u: (F8, F8)) -> Option<OnLight> {
+    pub(crate) fn drawn_ahead(&self, u: (F8, F8)) -> Option<OnLight> {
         match &self.lights[..] {
             [Some(LaneLight::Cap(cap))] => Some(on_caps(&PerLane::One(cap), u)),
             [Some(LaneLight::Triangle(triangle))] => Some(on_triangles(&PerLane::One(triangle), u)),
@@ -363,19 +363,19 @@ fn on_triangles(triangles: &PerLane<TriangleLight>, u: (F8, F8)) -> OnLight {
 }
 
 /// Light samples in eight lanes (only lanes of the mask are meaningful).
-pub(super) struct LightLanes {
-    pub(super) valid: M8,
-    pub(super) delta: M8,
-    pub(super) wi: V8,
+pub(crate) struct LightLanes {
+    pub(crate) valid: M8,
+    pub(crate) delta: M8,
+    pub(crate) wi: V8,
     /// Radiance over pdf (or the delta light's irradiance).
-    pub(super) value: V8,
-    pub(super) pdf: F8,
-    pub(super) origin: V8,
-    pub(super) t_max: F8,
+    pub(crate) value: V8,
+    pub(crate) pdf: F8,
+    pub(crate) origin: V8,
+    pub(crate) t_max: F8,
     /// The point drawn and the light's normal there (`LightSample::point`
     /// and `normal`): what bidirectional methods weigh a sample by.
-    pub(super) point: V8,
-    pub(super) light_normal: V8,
+    pub(crate) point: V8,
+    pub(crate) light_normal: V8,
 }
 
 impl LightLanes {
@@ -399,7 +399,7 @@ impl LightLanes {
     /// in the lanes.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    pub(super) fn sample(
+    pub(crate) fn sample(
         lights: &LaneLights,
         world: &World,
         pick: &[usize; LANES],
@@ -504,7 +504,7 @@ pub(crate) struct EmittedLanes {
 /// Points drawn uniformly on area lights: before their direction (light
 /// leaving them), or before the point they light is known (on caps and
 /// triangles the draw does not depend on it).
-pub(super) struct OnLight {
+pub(crate) struct OnLight {
     point: V8,
     normal: V8,
     error: F8,

@@ -2,13 +2,13 @@
 //! what a light sample lies on.
 
 use super::hits::RunCrossing;
-use super::{Occluder, PathLanes};
+use super::{LaneWorld, Occluder};
 use crate::geometry::plane_t_of;
 use crate::geometry::sphere::nearest_root;
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
 use crate::render::world::occluders::Shadow;
 
-impl PathLanes {
+impl LaneWorld {
     /// Lanes whose segment (origin, unit direction, t_max) meets `sphere`.
     #[inline(always)]
     fn hits(sphere: &Occluder, origin: V8, direction: V8, t_max: F8) -> M8 {
@@ -20,7 +20,7 @@ impl PathLanes {
     /// blocked; paths inside every wall skip the walls, and each ray what
     /// `skips` says it ends on (`Occluders::blocks_shadow`).
     #[inline(always)]
-    pub(super) fn blocked(
+    pub(crate) fn blocked(
         &self,
         mask: M8,
         inside_walls: M8,
@@ -80,7 +80,7 @@ impl PathLanes {
     /// where the CPU has AVX2.
     pub fn shadows_blocked(&self, shadows: &[Shadow], blocked: &mut [bool]) {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: the CPU has AVX2: a `PathLanes` is made only where it does.
+        // SAFETY: the CPU has AVX2: a `LaneWorld` is made only where it does.
         #[allow(unsafe_code)]
         unsafe {
             self.shadows_blocked_avx2(shadows, blocked)
@@ -117,7 +117,7 @@ impl PathLanes {
 
 /// What shadow rays need not test (`Occluders::blocks_shadow`): the sphere
 /// a light sample lies on, and the light plane of the triangle it lies on.
-pub(super) enum Skips {
+pub(crate) enum Skips {
     /// The same for every lane (path tracing toward a scene's one light).
     All {
         sphere: Option<u32>,
