@@ -806,3 +806,60 @@ fn a_vcm_pane_chooses_where_it_merges() {
     harness.get_by_label("balance");
     assert!(harness.query_by_label("merge caustic paths only").is_none(), "BDPT offers where to merge");
 }
+
+/// Ctrl and the wheel over a pane zoom every pane's image about the
+/// pointer and leave the camera alone (no edit, no restart); F shows the
+/// whole images again.
+#[test]
+fn ctrl_and_the_wheel_zoom_the_images_not_the_camera() {
+    let mut harness = studio(2);
+    step_until(&mut harness, |app| app.panes().list().iter().all(|p| p.state().passes() >= 1));
+    let original = harness.state().scene().clone();
+    let generations = harness.state().panes().generations();
+    let rect = harness.state().panes().rects()[0];
+    harness.hover_at(rect.center() + egui::vec2(rect.width() * 0.25, 0.0));
+    harness.run_steps(1);
+    for _ in 0..3 {
+        harness.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Line,
+            delta: egui::vec2(0.0, 1.0),
+            phase: egui::TouchPhase::Move,
+            source: egui::MouseWheelSource::Wheel,
+            modifiers: egui::Modifiers::COMMAND,
+        });
+        harness.run_steps(1);
+    }
+    harness.run_steps(8);
+    let view = *harness.state().panes().view();
+    assert!(view.zoom() > 1.5, "Ctrl and the wheel did not zoom: {view:?}");
+    // About the pointer, right of the middle: the view moved right
+    assert!(view.visible().center().x > 0.5, "{view:?}");
+    assert_eq!(*harness.state().scene(), original, "zooming the images moved the camera");
+    assert_eq!(harness.state().panes().generations(), generations, "zooming the images restarted a pane");
+    harness.key_press(egui::Key::F);
+    harness.run_steps(2);
+    assert!(harness.state().panes().view().fits(), "{:?}", harness.state().panes().view());
+}
+
+/// The pointer over one pane reads out the pixel under it in every pane:
+/// each pane's own value there, bit for bit what its image holds.
+#[test]
+fn every_pane_reads_out_the_pixel_under_the_pointer() {
+    let mut harness = studio(2);
+    step_until(&mut harness, |app| app.panes().list().iter().all(|p| p.state().finished));
+    let rect = harness.state().panes().rects()[1];
+    // 64 × 48 images: 0.26 across and 0.51 down is pixel (16, 24)
+    harness.hover_at(rect.min + egui::vec2(rect.width() * 0.26, rect.height() * 0.51));
+    harness.run_steps(3);
+    let readouts = harness.query_all_by_label_contains("pixel (16, 24)").count();
+    assert_eq!(readouts, 2, "one read-out per pane");
+    for pane in harness.state().panes().list() {
+        let [r, g, b] = pane.state().image.get(16, 24);
+        let value = format!("RGB {r:.4} {g:.4} {b:.4}");
+        assert!(harness.query_by_label_contains(&value).is_some(), "no read-out shows {value}");
+    }
+    // Away from the images, no read-out
+    harness.hover_at(egui::pos2(2.0, 2.0));
+    harness.run_steps(3);
+    assert_eq!(harness.query_all_by_label_contains("pixel (").count(), 0);
+}

@@ -226,6 +226,8 @@ pub struct Pane {
     /// None when the OS refused its thread (said in `state.failed`).
     session: Option<RenderSession>,
     texture: Option<egui::TextureHandle>,
+    /// Whether the texture magnifies its pixels as squares.
+    texture_nearest: bool,
     strategy_view: StrategyView,
     /// On while the strategy view is open; every job of the pane reads it.
     strategies: Switch,
@@ -252,7 +254,17 @@ impl Pane {
             }
         };
         let (strategy_view, strategies) = (StrategyView::default(), Switch::default());
-        Self { state, settings, exposure, session, texture: None, strategy_view, strategies, warning: None }
+        Self {
+            state,
+            settings,
+            exposure,
+            session,
+            texture: None,
+            texture_nearest: false,
+            strategy_view,
+            strategies,
+            warning: None,
+        }
     }
 
     pub fn settings(&self) -> &RenderSettings {
@@ -357,13 +369,20 @@ impl Pane {
     /// tiles' pixels and asks for another frame for the rest: a frame that
     /// found whole passes of four panes waiting would otherwise take tens of
     /// milliseconds.
-    pub fn texture(&mut self, ctx: &egui::Context) -> &egui::TextureHandle {
+    /// `nearest`: pixels magnified as squares (looking closely), else blended.
+    pub fn texture(&mut self, ctx: &egui::Context, nearest: bool) -> &egui::TextureHandle {
         let image = &self.state.image;
         let size = [image.width as usize, image.height as usize];
-        let options = egui::TextureOptions::LINEAR;
+        let options = match nearest {
+            true => {
+                egui::TextureOptions { magnification: egui::TextureFilter::Nearest, ..egui::TextureOptions::LINEAR }
+            }
+            false => egui::TextureOptions::LINEAR,
+        };
         let tonemap = Tonemap::new(self.exposure);
-        let stale = self.texture.as_ref().is_none_or(|t| t.size() != size);
+        let stale = self.texture.as_ref().is_none_or(|t| t.size() != size) || self.texture_nearest != nearest;
         if stale {
+            self.texture_nearest = nearest;
             let rgba = image.to_rgba8(self.exposure);
             let full = egui::ColorImage::from_rgba_unmultiplied(size, &rgba);
             self.texture = Some(ctx.load_texture("pane", full, options));

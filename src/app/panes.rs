@@ -8,6 +8,7 @@ use std::sync::Arc;
 use eframe::egui;
 
 use super::document::Document;
+use super::image_view::ImageView;
 use super::inspector::Selection;
 use super::pane::Pane;
 use super::viewport::viewport_ui;
@@ -24,6 +25,8 @@ pub struct Panes {
     /// The render threads every pane shares (None: the OS refused them).
     workers: Option<Workers>,
     ctx: egui::Context,
+    /// How every pane shows its image: zoom, pan, the point read out.
+    view: ImageView,
 }
 
 /// The four panes' algorithms at first: the thesis' three and progressive
@@ -49,7 +52,8 @@ pub fn pane_count(wanted: usize) -> usize {
 impl Panes {
     /// Panes that share `workers`.
     pub fn new(ctx: &egui::Context, workers: Option<Workers>) -> Self {
-        Self { list: Vec::new(), rects: Vec::new(), area: egui::Rect::NOTHING, workers, ctx: ctx.clone() }
+        let view = ImageView::default();
+        Self { list: Vec::new(), rects: Vec::new(), area: egui::Rect::NOTHING, workers, ctx: ctx.clone(), view }
     }
 
     /// A pane's settings for `algorithm` among `count` panes of a scene.
@@ -159,8 +163,21 @@ impl Panes {
     /// The grid of panes, each with its header (algorithm, settings,
     /// restart, use as reference) and viewport. Returns the pane whose
     /// image the user made the reference.
-    pub fn panes_ui(&mut self, ui: &mut egui::Ui, document: &mut Document, selection: &mut Selection) -> Option<usize> {
+    pub fn panes_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        document: &mut Document,
+        selection: &mut Selection,
+        reference: Option<&Reference>,
+    ) -> Option<usize> {
         self.area = ui.max_rect();
+        // F: every image whole again (not while a field is being typed in)
+        if ui.ctx().memory(|m| m.focused().is_none()) && ui.input(|i| i.key_pressed(egui::Key::F)) {
+            self.view.fit();
+        }
+        // The point read out is last frame's: this frame's is known once
+        // every pane has been asked where the pointer is
+        let shown = self.view.hovered.take();
         let count = self.list.len();
         let columns = if count == 1 { 1 } else { 2 };
         let rows = count.div_ceil(columns);
@@ -173,7 +190,7 @@ impl Panes {
             let min = origin + egui::vec2(column as f32 * cell.x, row as f32 * cell.y);
             let rect = egui::Rect::from_min_size(min, cell).shrink(3.0);
             let mut child = ui.new_child(egui::UiBuilder::new().max_rect(rect).id_salt(("pane", index)));
-            let (drawn, promote) = self.pane_ui(&mut child, index, document, selection);
+            let (drawn, promote) = self.pane_ui(&mut child, index, document, selection, shown, reference);
             self.rects[index] = drawn;
             if promote {
                 promoted = Some(index);
@@ -182,12 +199,15 @@ impl Panes {
         promoted
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn pane_ui(
         &mut self,
         ui: &mut egui::Ui,
         index: usize,
         document: &mut Document,
         selection: &mut Selection,
+        shown: Option<egui::Vec2>,
+        reference: Option<&Reference>,
     ) -> (egui::Rect, bool) {
         let pane = &mut self.list[index];
         let (mut restart, mut promote) = (false, false);
@@ -215,7 +235,13 @@ impl Panes {
                 pane.restart(scene.clone());
             }
         }
-        (viewport_ui(ui, pane, document, selection).rect, promote)
+        let reference = reference.map(|r| &r.image);
+        (viewport_ui(ui, pane, document, selection, &mut self.view, shown, reference).rect, promote)
+    }
+
+    /// How the panes show their images.
+    pub fn view(&self) -> &ImageView {
+        &self.view
     }
 
     /// The generation each pane is rendering (tests watch restarts with it).

@@ -1,13 +1,18 @@
-//! A pane's viewport: the image fitted to the pane, its label, and the
-//! mouse: click picks the object under the cursor, drag orbits the camera
-//! about its look-at point, shift-drag pans, scroll dollies.
+//! A pane's viewport: the image fitted to the pane (or the part of it the
+//! shared `ImageView` shows), its label, the read-out under the pointer,
+//! and the mouse: click picks the object under the cursor, drag orbits the
+//! camera about its look-at point, shift-drag pans, scroll dollies; with
+//! Ctrl (⌘) the wheel zooms the images and a drag pans them.
 
 use eframe::egui;
 use glam::{Quat, Vec3};
 
 use super::document::Document;
+use super::image_view::{screen_point, ImageView, GRID_FROM, NEAREST_FROM};
 use super::inspector::Selection;
 use super::pane::Pane;
+use super::readout::{readout_ui, Readout};
+use crate::render::image::LinearImage;
 use crate::scene::Camera;
 
 /// Turn the camera about its look-at point: `yaw` about the up vector,
@@ -55,22 +60,31 @@ pub fn dolly(camera: &mut Camera, factor: f32) {
     }
 }
 
-/// Draw the pane and apply its interactions to the document's camera (a
-/// change of it is an edit) and the selection.
+/// Draw the pane and apply its interactions: to the document's camera (a
+/// change of it is an edit) and the selection, or with Ctrl (⌘) held to the
+/// panes' shared `view` (the wheel zooms about the pointer, a drag pans).
+/// `shown` is the image point whose values every pane reads out; the point
+/// under the pointer here goes into `view.hovered`.
 pub fn viewport_ui(
     ui: &mut egui::Ui,
     pane: &mut Pane,
     document: &mut Document,
     selection: &mut Selection,
+    view: &mut ImageView,
+    shown: Option<egui::Vec2>,
+    reference: Option<&LinearImage>,
 ) -> egui::Response {
-    let texture = pane.texture(ui.ctx()).clone();
-    let (width, height) = (pane.state().image.width as f32, pane.state().image.height as f32);
+    let (width, height) = (pane.state().image.width, pane.state().image.height);
     let available = ui.available_size();
-    let scale = (available.x / width).min(available.y / height).max(0.01);
+    let scale = (available.x / width as f32).min(available.y / height as f32).max(0.01);
     let (rect, response) =
-        ui.allocate_exact_size(egui::vec2(width * scale, height * scale), egui::Sense::click_and_drag());
-    let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
-    ui.painter().image(texture.id(), rect, uv, egui::Color32::WHITE);
+        ui.allocate_exact_size(egui::vec2(width as f32 * scale, height as f32 * scale), egui::Sense::click_and_drag());
+    let pixel_size = view.pixel_size(rect.width(), width);
+    let texture = pane.texture(ui.ctx(), pixel_size >= NEAREST_FROM).clone();
+    ui.painter().image(texture.id(), rect, view.visible(), egui::Color32::WHITE);
+    if pixel_size >= GRID_FROM {
+        pixel_grid_ui(ui, rect, view, width, height);
+    }
     let label = pane.label();
     // Painted over the image, and told to screen readers (and tests) too
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, &label));
@@ -103,36 +117,81 @@ pub fn viewport_ui(
             ui.visuals().error_fg_color,
         );
     }
+    let pixel = shown.and_then(|point| ImageView::pixel(point, width, height));
+    if let Some(readout) = pixel.and_then(|pixel| Readout::of(&pane.state().image, pixel, reference)) {
+        if pixel_size >= NEAREST_FROM {
+            let (x, y) = readout.pixel;
+            let corner = |x: u32, y: u32| {
+                screen_point(view, rect, egui::vec2(x as f32 / width as f32, y as f32 / height as f32))
+            };
+            let outline = egui::Rect::from_min_max(corner(x, y), corner(x + 1, y + 1));
+            ui.painter().with_clip_rect(rect).rect_stroke(
+                outline,
+                0.0,
+                egui::Stroke::new(1.5, egui::Color32::YELLOW),
+                egui::StrokeKind::Middle,
+            );
+        }
+        readout_ui(ui, rect, &readout);
+    }
 
-    let to_film = |pos: egui::Pos2| ((pos.x - rect.min.x) / scale, (pos.y - rect.min.y) / scale);
+    let to_film = |pos: egui::Pos2| {
+        let point = view.image_point(rect, pos);
+        (point.x * width as f32, point.y * height as f32)
+    };
     if response.clicked() {
         if let Some(pos) = response.interact_pointer_pos() {
             let (x, y) = to_film(pos);
-            match document.pick(width as u32, height as u32, x, y) {
+            match document.pick(width, height, x, y) {
                 Some(object) => *selection = Selection::Object(object),
                 None => *selection = Selection::Camera,
             }
         }
     }
+    let looking = ui.input(|i| i.modifiers.command);
     let delta = response.drag_delta();
     if response.dragged() && delta != egui::Vec2::ZERO {
-        let camera = &mut document.scene_mut().camera;
-        if ui.input(|i| i.modifiers.shift) {
-            pan(camera, delta.x / rect.height(), delta.y / rect.height());
+        if looking {
+            view.pan(delta, rect);
         } else {
-            let (yaw, pitch) = orbit_angles(camera, delta, rect.height());
-            orbit(camera, yaw, pitch);
+            let camera = &mut document.scene_mut().camera;
+            if ui.input(|i| i.modifiers.shift) {
+                pan(camera, delta.x / rect.height(), delta.y / rect.height());
+            } else {
+                let (yaw, pitch) = orbit_angles(camera, delta, rect.height());
+                orbit(camera, yaw, pitch);
+            }
+            document.changed();
         }
-        document.changed();
     }
-    if response.hovered() {
+    if let Some(pos) = response.hover_pos() {
+        let point = view.image_point(rect, pos);
+        view.hovered = Some(point);
+        // Ctrl (⌘) with the wheel, or a pinch, zooms the images
+        let zoom = ui.input(|i| i.zoom_delta());
+        if zoom != 1.0 {
+            view.zoom_about(zoom, point);
+        }
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
-        if scroll != 0.0 {
+        if scroll != 0.0 && !looking {
             dolly(&mut document.scene_mut().camera, (-scroll * 0.002).exp());
             document.changed();
         }
     }
     response
+}
+
+/// Lines at the edges of the pixels shown, when each is large on screen.
+fn pixel_grid_ui(ui: &egui::Ui, rect: egui::Rect, view: &ImageView, width: u32, height: u32) {
+    let painter = ui.painter().with_clip_rect(rect);
+    let stroke = egui::Stroke::new(1.0, egui::Color32::from_black_alpha(90));
+    let (columns, rows) = view.grid(rect, width, height);
+    for x in columns {
+        painter.vline(x, rect.y_range(), stroke);
+    }
+    for y in rows {
+        painter.hline(rect.x_range(), y, stroke);
+    }
 }
 
 #[cfg(test)]

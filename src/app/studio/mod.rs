@@ -264,7 +264,9 @@ impl StudioApp {
             });
         }
         let promoted = egui::CentralPanel::default()
-            .show(ui, |ui| self.panes.panes_ui(ui, &mut self.document, &mut self.selection))
+            .show(ui, |ui| {
+                self.panes.panes_ui(ui, &mut self.document, &mut self.selection, self.references.reference())
+            })
             .inner;
         self.dialogs.dialogs_ui(&ctx, self.document.path(), &mut commands);
         if self.shown.difference {

@@ -1,0 +1,133 @@
+//! The values under the pointer: in every pane, the pixel's linear RGB,
+//! the reference's value there and the pixel's relative error (its term in
+//! the pane's relMSE), wherever the pointer is.
+
+use eframe::egui;
+
+use crate::render::film::REL_MSE_EPSILON;
+use crate::render::image::LinearImage;
+
+/// What one pane reads at one pixel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Readout {
+    pub pixel: (u32, u32),
+    pub value: [f32; 3],
+    /// The reference's value over the same area, where there is a
+    /// reference at this size or a whole multiple of it.
+    pub reference: Option<[f32; 3]>,
+}
+
+impl Readout {
+    /// Pixel `pixel` of `image`, against `reference` if given.
+    pub fn of(image: &LinearImage, pixel: (u32, u32), reference: Option<&LinearImage>) -> Option<Self> {
+        let (x, y) = pixel;
+        if x >= image.width || y >= image.height {
+            return None;
+        }
+        let reference = reference.and_then(|r| area_mean(r, image.width, image.height, pixel));
+        Some(Readout { pixel, value: image.get(x, y), reference })
+    }
+
+    /// (v − r)² / (r² + ε) averaged over the channels: this pixel's term in
+    /// the relMSE the pane shows.
+    pub fn relative_error(&self) -> Option<f64> {
+        let reference = self.reference?;
+        let term = |c: usize| {
+            let (v, r) = (self.value[c] as f64, reference[c] as f64);
+            (v - r).powi(2) / (r * r + REL_MSE_EPSILON)
+        };
+        Some((term(0) + term(1) + term(2)) / 3.0)
+    }
+
+    pub fn text(&self) -> String {
+        let rgb = |c: [f32; 3]| format!("{:.4} {:.4} {:.4}", c[0], c[1], c[2]);
+        let mut text = format!("pixel ({}, {})\nRGB {}", self.pixel.0, self.pixel.1, rgb(self.value));
+        match (self.reference, self.relative_error()) {
+            (Some(reference), Some(error)) => {
+                text += &format!("\nreference {}\nrel. error² {error:.2e}", rgb(reference));
+            }
+            _ => text += "\nno reference at this size",
+        }
+        text
+    }
+}
+
+/// The mean of `reference` over the area pixel `pixel` of a `width × height`
+/// image covers, where the reference is that size or a whole multiple of it
+/// (the box filter the panes' error uses).
+fn area_mean(reference: &LinearImage, width: u32, height: u32, (x, y): (u32, u32)) -> Option<[f32; 3]> {
+    let factor = reference.width / width.max(1);
+    if factor == 0 || reference.width != width * factor || reference.height != height * factor {
+        return None;
+    }
+    let mut sum = [0.0f64; 3];
+    for dy in 0..factor {
+        for dx in 0..factor {
+            let p = reference.get(x * factor + dx, y * factor + dy);
+            (0..3).for_each(|c| sum[c] += p[c] as f64);
+        }
+    }
+    let weight = 1.0 / (factor * factor) as f64;
+    Some(sum.map(|s| (s * weight) as f32))
+}
+
+/// The read-out drawn over the top right of a pane's image in `rect`.
+pub fn readout_ui(ui: &mut egui::Ui, rect: egui::Rect, readout: &Readout) {
+    let text = egui::RichText::new(readout.text()).monospace().color(egui::Color32::WHITE);
+    let area = egui::Rect::from_min_max(egui::pos2(rect.center().x, rect.min.y), rect.max).shrink(4.0);
+    let layout = egui::Layout::top_down(egui::Align::Max);
+    let mut child = ui.new_child(egui::UiBuilder::new().max_rect(area).layout(layout));
+    egui::Frame::new().fill(egui::Color32::from_black_alpha(180)).inner_margin(4.0).show(&mut child, |ui| {
+        ui.add(egui::Label::new(text).selectable(false));
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp(width: u32, height: u32) -> LinearImage {
+        let mut image = LinearImage::new(width, height);
+        for y in 0..height {
+            for x in 0..width {
+                image.pixels[(y * width + x) as usize] = [x as f32, y as f32, (x * y) as f32 * 0.5];
+            }
+        }
+        image
+    }
+
+    /// A reference twice or three times the pane's size is read as the mean
+    /// over the pixel's area, what `LinearImage::downsample` makes of it; a
+    /// reference of another size gives no value.
+    #[test]
+    fn the_reference_is_read_over_the_pixels_area() {
+        let pane = ramp(8, 6);
+        for factor in [1, 2, 3] {
+            let reference = ramp(8 * factor, 6 * factor);
+            let filtered = reference.downsample(factor);
+            for (x, y) in [(0, 0), (7, 5), (3, 2)] {
+                let readout = Readout::of(&pane, (x, y), Some(&reference)).expect("inside");
+                assert_eq!(readout.reference, Some(filtered.get(x, y)), "×{factor} at ({x}, {y})");
+                assert_eq!(readout.value, pane.get(x, y));
+            }
+        }
+        let odd = ramp(12, 9);
+        assert_eq!(Readout::of(&pane, (1, 1), Some(&odd)).and_then(|r| r.reference), None);
+        assert_eq!(Readout::of(&pane, (8, 0), None), None);
+    }
+
+    /// The error is the pixel's relMSE term: zero on the reference, and
+    /// (v − r)²/(r² + ε) per channel otherwise.
+    #[test]
+    fn the_relative_error_is_the_relmse_term() {
+        let exact = Readout { pixel: (0, 0), value: [0.5, 1.0, 2.0], reference: Some([0.5, 1.0, 2.0]) };
+        assert_eq!(exact.relative_error(), Some(0.0));
+        let off = Readout { pixel: (0, 0), value: [1.0, 1.0, 1.0], reference: Some([0.5, 1.0, 0.0]) };
+        let expected = (0.25 / (0.25 + REL_MSE_EPSILON) + 1.0 / REL_MSE_EPSILON) / 3.0;
+        assert!((off.relative_error().unwrap() - expected).abs() < 1e-9 * expected);
+        let alone = Readout { reference: None, ..off };
+        assert_eq!(alone.relative_error(), None);
+        assert!(alone.text().contains("no reference"), "{}", alone.text());
+        assert!(off.text().contains("reference 0.5000 1.0000 0.0000"), "{}", off.text());
+    }
+}
