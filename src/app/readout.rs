@@ -1,6 +1,7 @@
 //! The values under the pointer: in every pane, the pixel's linear RGB,
-//! the reference's value there and the pixel's relative error (its term in
-//! the pane's relMSE), wherever the pointer is.
+//! the reference's value there and the pixel's squared relative error
+//! (v − r)²/(r² + ε), the term relMSE averages (the pane's figure divides
+//! by a reference smoothed within its noise, and takes off its noise).
 
 use eframe::egui;
 
@@ -13,8 +14,14 @@ pub struct Readout {
     pub pixel: (u32, u32),
     pub value: [f32; 3],
     /// The reference's value over the same area, where there is a
-    /// reference at this size or a whole multiple of it.
+    /// reference at this size or a whole multiple of it, or a whole
+    /// fraction of it (then over the block of `block` × `block` pixels the
+    /// reference's pixel covers).
     pub reference: Option<[f32; 3]>,
+    /// What is compared with the reference: the value, or the block's mean
+    /// where the reference is smaller (as the pane's error is measured).
+    pub compared: [f32; 3],
+    pub block: u32,
 }
 
 impl Readout {
@@ -24,16 +31,30 @@ impl Readout {
         if x >= image.width || y >= image.height {
             return None;
         }
-        let reference = reference.and_then(|r| area_mean(r, image.width, image.height, pixel));
-        Some(Readout { pixel, value: image.get(x, y), reference })
+        let value = image.get(x, y);
+        let mut readout = Readout { pixel, value, reference: None, compared: value, block: 1 };
+        let Some(reference) = reference else { return Some(readout) };
+        if let Some(mean) = area_mean(reference, image.width, image.height, pixel) {
+            readout.reference = Some(mean);
+        } else {
+            // A reference smaller by a whole factor: the pane is measured
+            // box-filtered to its size, so this pixel counts in its block
+            let block = image.width / reference.width.max(1);
+            if let Some(mean) =
+                area_mean(image, reference.width, reference.height, (x / block.max(1), y / block.max(1)))
+            {
+                readout.reference = Some(reference.get(x / block, y / block));
+                (readout.compared, readout.block) = (mean, block);
+            }
+        }
+        Some(readout)
     }
 
-    /// (v − r)² / (r² + ε) averaged over the channels: this pixel's term in
-    /// the relMSE the pane shows.
+    /// (v − r)² / (r² + ε) averaged over the channels.
     pub fn relative_error(&self) -> Option<f64> {
         let reference = self.reference?;
         let term = |c: usize| {
-            let (v, r) = (self.value[c] as f64, reference[c] as f64);
+            let (v, r) = (self.compared[c] as f64, reference[c] as f64);
             (v - r).powi(2) / (r * r + REL_MSE_EPSILON)
         };
         Some((term(0) + term(1) + term(2)) / 3.0)
@@ -43,6 +64,11 @@ impl Readout {
         let rgb = |c: [f32; 3]| format!("{:.4} {:.4} {:.4}", c[0], c[1], c[2]);
         let mut text = format!("pixel ({}, {})\nRGB {}", self.pixel.0, self.pixel.1, rgb(self.value));
         match (self.reference, self.relative_error()) {
+            (Some(reference), Some(error)) if self.block > 1 => {
+                let (block, mean) = (self.block, rgb(self.compared));
+                text +=
+                    &format!("\n{block}×{block} mean {mean}\nreference {}\nrel. error² {error:.2e}", rgb(reference));
+            }
             (Some(reference), Some(error)) => {
                 text += &format!("\nreference {}\nrel. error² {error:.2e}", rgb(reference));
             }
@@ -52,18 +78,18 @@ impl Readout {
     }
 }
 
-/// The mean of `reference` over the area pixel `pixel` of a `width × height`
-/// image covers, where the reference is that size or a whole multiple of it
-/// (the box filter the panes' error uses).
-fn area_mean(reference: &LinearImage, width: u32, height: u32, (x, y): (u32, u32)) -> Option<[f32; 3]> {
-    let factor = reference.width / width.max(1);
-    if factor == 0 || reference.width != width * factor || reference.height != height * factor {
+/// The mean of `image` over the area pixel `pixel` of a `width × height`
+/// image covers, where `image` is that size or a whole multiple of it (the
+/// box filter the panes' error uses).
+fn area_mean(image: &LinearImage, width: u32, height: u32, (x, y): (u32, u32)) -> Option<[f32; 3]> {
+    let factor = image.width / width.max(1);
+    if factor == 0 || image.width != width * factor || image.height != height * factor {
         return None;
     }
     let mut sum = [0.0f64; 3];
     for dy in 0..factor {
         for dx in 0..factor {
-            let p = reference.get(x * factor + dx, y * factor + dy);
+            let p = image.get(x * factor + dx, y * factor + dy);
             (0..3).for_each(|c| sum[c] += p[c] as f64);
         }
     }
@@ -113,6 +139,12 @@ mod tests {
         }
         let odd = ramp(12, 9);
         assert_eq!(Readout::of(&pane, (1, 1), Some(&odd)).and_then(|r| r.reference), None);
+        // A reference half the size: its pixel, against the pane's 2 × 2 block
+        let small = ramp(4, 3);
+        let readout = Readout::of(&pane, (5, 3), Some(&small)).expect("inside");
+        assert_eq!(readout.reference, Some(small.get(2, 1)));
+        assert_eq!((readout.compared, readout.block), (pane.downsample(2).get(2, 1), 2));
+        assert_eq!(readout.value, pane.get(5, 3));
         assert_eq!(Readout::of(&pane, (8, 0), None), None);
     }
 
@@ -120,9 +152,10 @@ mod tests {
     /// (v − r)²/(r² + ε) per channel otherwise.
     #[test]
     fn the_relative_error_is_the_relmse_term() {
-        let exact = Readout { pixel: (0, 0), value: [0.5, 1.0, 2.0], reference: Some([0.5, 1.0, 2.0]) };
+        let at = |value: [f32; 3], reference| Readout { pixel: (0, 0), value, reference, compared: value, block: 1 };
+        let exact = at([0.5, 1.0, 2.0], Some([0.5, 1.0, 2.0]));
         assert_eq!(exact.relative_error(), Some(0.0));
-        let off = Readout { pixel: (0, 0), value: [1.0, 1.0, 1.0], reference: Some([0.5, 1.0, 0.0]) };
+        let off = at([1.0, 1.0, 1.0], Some([0.5, 1.0, 0.0]));
         let expected = (0.25 / (0.25 + REL_MSE_EPSILON) + 1.0 / REL_MSE_EPSILON) / 3.0;
         assert!((off.relative_error().unwrap() - expected).abs() < 1e-9 * expected);
         let alone = Readout { reference: None, ..off };
