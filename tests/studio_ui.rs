@@ -863,3 +863,41 @@ fn every_pane_reads_out_the_pixel_under_the_pointer() {
     harness.run_steps(3);
     assert_eq!(harness.query_all_by_label_contains("pixel (").count(), 0);
 }
+
+/// A wipe shows pane 2's image right of a divider over pane 1; dragging
+/// the divider moves it by the dragged share of the pane and leaves the
+/// camera alone; choosing Off ends it.
+#[test]
+fn a_wipe_divider_follows_the_drag_and_not_the_camera() {
+    let mut harness = studio(2);
+    step_until(&mut harness, |app| app.panes().list().iter().all(|p| p.state().passes() >= 1));
+    let original = harness.state().scene().clone();
+    harness.get_all_by_label("Wipe").next().expect("pane 1's wipe menu").click();
+    harness.run_steps(2);
+    harness.get_by_label("with pane 2").click();
+    harness.run_steps(3);
+    let wipe = harness.state().panes().wipe(0).expect("the wipe is on");
+    assert_eq!((wipe.other, wipe.divider), (1, 0.5));
+    assert!(harness.query_by_label("wipe pane 1 | pane 2").is_some(), "no divider drawn");
+    let rect = harness.state().panes().rects()[0];
+    let start = rect.center();
+    harness.hover_at(start);
+    harness.run_steps(1);
+    harness.drag_at(start);
+    harness.run_steps(1);
+    let dx = -rect.width() / 4.0;
+    for step in 1..=5 {
+        harness.hover_at(start + egui::vec2(dx * step as f32 / 5.0, 0.0));
+        harness.run_steps(1);
+    }
+    harness.drop_at(start + egui::vec2(dx, 0.0));
+    harness.run_steps(2);
+    let divider = harness.state().panes().wipe(0).expect("still on").divider;
+    assert!((divider - 0.25).abs() < 0.01, "the divider stands at {divider}, not 0.25");
+    assert_eq!(*harness.state().scene(), original, "dragging the divider moved the camera");
+    harness.get_all_by_label("Wipe").next().expect("pane 1's wipe menu").click();
+    harness.run_steps(2);
+    harness.get_by_label("Off").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().panes().wipe(0), None);
+}

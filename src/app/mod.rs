@@ -28,6 +28,7 @@ mod studio;
 mod viewport;
 mod widgets;
 mod window_lost;
+mod wipe;
 
 pub use commands::Action;
 pub use inspector::Selection;

@@ -369,6 +369,11 @@ impl Pane {
     /// tiles' pixels and asks for another frame for the rest: a frame that
     /// found whole passes of four panes waiting would otherwise take tens of
     /// milliseconds.
+    /// The texture as it is, for another pane to draw (a wipe).
+    pub fn texture_id(&self) -> Option<egui::TextureId> {
+        self.texture.as_ref().map(|t| t.id())
+    }
+
     /// `nearest`: pixels magnified as squares (looking closely), else blended.
     pub fn texture(&mut self, ctx: &egui::Context, nearest: bool) -> &egui::TextureHandle {
         let image = &self.state.image;

@@ -11,7 +11,8 @@ use super::document::Document;
 use super::image_view::ImageView;
 use super::inspector::Selection;
 use super::pane::Pane;
-use super::viewport::viewport_ui;
+use super::viewport::{viewport_ui, Look};
+use super::wipe::Wipe;
 use crate::analysis::reference::Reference;
 use crate::render::{Algorithm, RenderSettings, Workers};
 use crate::scene::{SceneSettings, ValidScene};
@@ -27,6 +28,8 @@ pub struct Panes {
     ctx: egui::Context,
     /// How every pane shows its image: zoom, pan, the point read out.
     view: ImageView,
+    /// Each pane's wipe to another pane's image, if on.
+    wipes: Vec<Option<Wipe>>,
 }
 
 /// The four panes' algorithms at first: the thesis' three and progressive
@@ -53,7 +56,15 @@ impl Panes {
     /// Panes that share `workers`.
     pub fn new(ctx: &egui::Context, workers: Option<Workers>) -> Self {
         let view = ImageView::default();
-        Self { list: Vec::new(), rects: Vec::new(), area: egui::Rect::NOTHING, workers, ctx: ctx.clone(), view }
+        Self {
+            list: Vec::new(),
+            rects: Vec::new(),
+            area: egui::Rect::NOTHING,
+            workers,
+            ctx: ctx.clone(),
+            view,
+            wipes: Vec::new(),
+        }
     }
 
     /// A pane's settings for `algorithm` among `count` panes of a scene.
@@ -184,6 +195,13 @@ impl Panes {
         let cell = egui::vec2(ui.available_width() / columns as f32, ui.available_height() / rows as f32);
         let origin = ui.min_rect().min;
         self.rects.resize(count, egui::Rect::NOTHING);
+        self.wipes.resize(count, None);
+        for (index, wipe) in self.wipes.iter_mut().enumerate() {
+            // A wipe to a pane that went away ends
+            if wipe.is_some_and(|w| w.other >= count || w.other == index) {
+                *wipe = None;
+            }
+        }
         let mut promoted = None;
         for index in 0..count {
             let (row, column) = (index / columns, index % columns);
@@ -209,7 +227,10 @@ impl Panes {
         shown: Option<egui::Vec2>,
         reference: Option<&Reference>,
     ) -> (egui::Rect, bool) {
+        let count = self.list.len();
+        let other_texture = self.wipes[index].and_then(|w| self.list[w.other].texture_id());
         let pane = &mut self.list[index];
+        let wipe = &mut self.wipes[index];
         let (mut restart, mut promote) = (false, false);
         // Wrapped within the pane's own width: a row that ran on would put
         // its last buttons in the next pane's header
@@ -219,6 +240,10 @@ impl Panes {
             restart |= ui.small_button("Restart").on_hover_text("Restart this pane").clicked();
             let hint = "Measure every pane against this pane's image from now on";
             promote |= ui.small_button("Use as reference").on_hover_text(hint).clicked();
+            if count > 1 {
+                let hint = "Show another pane's image right of a divider you drag";
+                ui.menu_button("Wipe", |ui| wipe_menu_ui(ui, wipe, index, count)).response.on_hover_text(hint);
+            }
             if pane.has_strategies() {
                 let open = pane.strategy_view_mut().open;
                 let hint = "What each way of joining light and camera paths brings to this pane, from the next pass";
@@ -236,7 +261,20 @@ impl Panes {
             }
         }
         let reference = reference.map(|r| &r.image);
-        (viewport_ui(ui, pane, document, selection, &mut self.view, shown, reference).rect, promote)
+        let wipe = match (wipe.as_mut(), other_texture) {
+            (Some(wipe), Some(texture)) => {
+                let names = [format!("pane {}", index + 1), format!("pane {}", wipe.other + 1)];
+                Some((wipe, texture, names))
+            }
+            _ => None,
+        };
+        let look = Look { view: &mut self.view, shown, reference, wipe };
+        (viewport_ui(ui, pane, document, selection, look).rect, promote)
+    }
+
+    /// Pane `index`'s wipe, if on.
+    pub fn wipe(&self, index: usize) -> Option<Wipe> {
+        self.wipes.get(index).copied().flatten()
     }
 
     /// How the panes show their images.
@@ -247,5 +285,20 @@ impl Panes {
     /// The generation each pane is rendering (tests watch restarts with it).
     pub fn generations(&self) -> Vec<u64> {
         self.list.iter().map(|p| p.state().generation).collect()
+    }
+}
+
+/// The choice of the pane wiped over pane `index`, or none.
+fn wipe_menu_ui(ui: &mut egui::Ui, wipe: &mut Option<Wipe>, index: usize, count: usize) {
+    if ui.selectable_label(wipe.is_none(), "Off").clicked() {
+        *wipe = None;
+        ui.close();
+    }
+    for other in (0..count).filter(|&other| other != index) {
+        let on = wipe.is_some_and(|w| w.other == other);
+        if ui.selectable_label(on, format!("with pane {}", other + 1)).clicked() {
+            *wipe = Some(Wipe::new(other));
+            ui.close();
+        }
     }
 }

@@ -12,6 +12,7 @@ use super::image_view::{screen_point, ImageView, GRID_FROM, NEAREST_FROM};
 use super::inspector::Selection;
 use super::pane::Pane;
 use super::readout::{readout_ui, Readout};
+use super::wipe::{wipe_ui, Wipe};
 use crate::render::image::LinearImage;
 use crate::scene::Camera;
 
@@ -60,20 +61,28 @@ pub fn dolly(camera: &mut Camera, factor: f32) {
     }
 }
 
+/// How a pane is looked at: the panes' shared view; the image point whose
+/// values every pane reads out (the point under the pointer here goes into
+/// `view.hovered`); the reference; another pane's image wiped over this
+/// one (its texture and both panes' names).
+pub struct Look<'a> {
+    pub view: &'a mut ImageView,
+    pub shown: Option<egui::Vec2>,
+    pub reference: Option<&'a LinearImage>,
+    pub wipe: Option<(&'a mut Wipe, egui::TextureId, [String; 2])>,
+}
+
 /// Draw the pane and apply its interactions: to the document's camera (a
 /// change of it is an edit) and the selection, or with Ctrl (⌘) held to the
-/// panes' shared `view` (the wheel zooms about the pointer, a drag pans).
-/// `shown` is the image point whose values every pane reads out; the point
-/// under the pointer here goes into `view.hovered`.
+/// panes' shared view (the wheel zooms about the pointer, a drag pans).
 pub fn viewport_ui(
     ui: &mut egui::Ui,
     pane: &mut Pane,
     document: &mut Document,
     selection: &mut Selection,
-    view: &mut ImageView,
-    shown: Option<egui::Vec2>,
-    reference: Option<&LinearImage>,
+    look: Look<'_>,
 ) -> egui::Response {
+    let Look { view, shown, reference, wipe } = look;
     let (width, height) = (pane.state().image.width, pane.state().image.height);
     let available = ui.available_size();
     let scale = (available.x / width as f32).min(available.y / height as f32).max(0.01);
@@ -84,6 +93,9 @@ pub fn viewport_ui(
     ui.painter().image(texture.id(), rect, view.visible(), egui::Color32::WHITE);
     if pixel_size >= GRID_FROM {
         pixel_grid_ui(ui, rect, view, width, height);
+    }
+    if let Some((wipe, other, names)) = wipe {
+        wipe_ui(ui, rect, wipe, other, view, names);
     }
     let label = pane.label();
     // Painted over the image, and told to screen readers (and tests) too
