@@ -97,11 +97,12 @@ fn area_mean(image: &LinearImage, width: u32, height: u32, (x, y): (u32, u32)) -
     Some(sum.map(|s| (s * weight) as f32))
 }
 
-/// The read-out drawn over the top right of a pane's image in `rect`.
+/// The read-out drawn over the bottom right of a pane's image in `rect`
+/// (the pane's label is at the top).
 pub fn readout_ui(ui: &mut egui::Ui, rect: egui::Rect, readout: &Readout) {
     let text = egui::RichText::new(readout.text()).monospace().color(egui::Color32::WHITE);
     let area = egui::Rect::from_min_max(egui::pos2(rect.center().x, rect.min.y), rect.max).shrink(4.0);
-    let layout = egui::Layout::top_down(egui::Align::Max);
+    let layout = egui::Layout::bottom_up(egui::Align::Max);
     let mut child = ui.new_child(egui::UiBuilder::new().max_rect(area).layout(layout));
     egui::Frame::new().fill(egui::Color32::from_black_alpha(180)).inner_margin(4.0).show(&mut child, |ui| {
         ui.add(egui::Label::new(text).selectable(false));

@@ -7,7 +7,7 @@ use eframe::egui;
 use super::image_view::ImageView;
 
 /// Half the width of the divider's handle, in screen points.
-const HANDLE: f32 = 6.0;
+const HANDLE: f32 = 8.0;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Wipe {
