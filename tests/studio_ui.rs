@@ -7,7 +7,7 @@ use eframe::Storage as _;
 use egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
-use gi_studio::app::{Selection, StudioApp};
+use gi_studio::app::{Against, Selection, StudioApp};
 use gi_studio::app::{StateFile, StudioArgs};
 use gi_studio::render::world::camera::CameraModel;
 use gi_studio::render::Algorithm;
@@ -877,7 +877,7 @@ fn a_wipe_divider_follows_the_drag_and_not_the_camera() {
     harness.get_by_label("with pane 2").click();
     harness.run_steps(3);
     let wipe = harness.state().panes().wipe(0).expect("the wipe is on");
-    assert_eq!((wipe.other, wipe.divider), (1, 0.5));
+    assert_eq!((wipe.other, wipe.divider), (Against::Pane(1), 0.5));
     assert!(harness.query_by_label("wipe pane 1 | pane 2").is_some(), "no divider drawn");
     let rect = harness.state().panes().rects()[0];
     let start = rect.center();
@@ -895,6 +895,13 @@ fn a_wipe_divider_follows_the_drag_and_not_the_camera() {
     let divider = harness.state().panes().wipe(0).expect("still on").divider;
     assert!((divider - 0.25).abs() < 0.01, "the divider stands at {divider}, not 0.25");
     assert_eq!(*harness.state().scene(), original, "dragging the divider moved the camera");
+    // Against the reference (the built-in one, there from the start)
+    harness.get_all_by_label("Wipe").next().expect("pane 1's wipe menu").click();
+    harness.run_steps(2);
+    harness.get_by_label("with the reference").click();
+    harness.run_steps(3);
+    assert_eq!(harness.state().panes().wipe(0).map(|w| w.other), Some(Against::Reference));
+    assert!(harness.query_by_label("wipe pane 1 | reference").is_some(), "no divider against the reference");
     harness.get_all_by_label("Wipe").next().expect("pane 1's wipe menu").click();
     harness.run_steps(2);
     harness.get_by_label("Off").click();

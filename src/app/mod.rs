@@ -29,6 +29,7 @@ mod viewport;
 mod widgets;
 mod window_lost;
 mod wipe;
+pub use wipe::Against;
 
 pub use commands::Action;
 pub use inspector::Selection;

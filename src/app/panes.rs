@@ -12,7 +12,7 @@ use super::image_view::ImageView;
 use super::inspector::Selection;
 use super::pane::Pane;
 use super::viewport::{viewport_ui, Look};
-use super::wipe::Wipe;
+use super::wipe::{Against, ReferenceTextures, Wipe};
 use crate::analysis::reference::Reference;
 use crate::render::{Algorithm, RenderSettings, Workers};
 use crate::scene::{SceneSettings, ValidScene};
@@ -28,8 +28,9 @@ pub struct Panes {
     ctx: egui::Context,
     /// How every pane shows its image: zoom, pan, the point read out.
     view: ImageView,
-    /// Each pane's wipe to another pane's image, if on.
+    /// Each pane's wipe to another pane's image or the reference, if on.
     wipes: Vec<Option<Wipe>>,
+    reference_textures: ReferenceTextures,
 }
 
 /// The four panes' algorithms at first: the thesis' three and progressive
@@ -55,15 +56,15 @@ pub fn pane_count(wanted: usize) -> usize {
 impl Panes {
     /// Panes that share `workers`.
     pub fn new(ctx: &egui::Context, workers: Option<Workers>) -> Self {
-        let view = ImageView::default();
         Self {
             list: Vec::new(),
             rects: Vec::new(),
             area: egui::Rect::NOTHING,
             workers,
             ctx: ctx.clone(),
-            view,
+            view: ImageView::default(),
             wipes: Vec::new(),
+            reference_textures: ReferenceTextures::default(),
         }
     }
 
@@ -198,7 +199,7 @@ impl Panes {
         self.wipes.resize(count, None);
         for (index, wipe) in self.wipes.iter_mut().enumerate() {
             // A wipe to a pane that went away ends
-            if wipe.is_some_and(|w| w.other >= count || w.other == index) {
+            if wipe.is_some_and(|w| matches!(w.other, Against::Pane(other) if other >= count || other == index)) {
                 *wipe = None;
             }
         }
@@ -228,7 +229,14 @@ impl Panes {
         reference: Option<&Reference>,
     ) -> (egui::Rect, bool) {
         let count = self.list.len();
-        let other_texture = self.wipes[index].and_then(|w| self.list[w.other].texture_id());
+        let other_texture = match self.wipes[index].map(|w| w.other) {
+            Some(Against::Pane(other)) => self.list[other].texture_id(),
+            Some(Against::Reference) => {
+                let exposure = self.list[index].exposure();
+                reference.map(|r| self.reference_textures.texture(&self.ctx, index, r, exposure))
+            }
+            None => None,
+        };
         let pane = &mut self.list[index];
         let wipe = &mut self.wipes[index];
         let (mut restart, mut promote) = (false, false);
@@ -240,10 +248,8 @@ impl Panes {
             restart |= ui.small_button("Restart").on_hover_text("Restart this pane").clicked();
             let hint = "Measure every pane against this pane's image from now on";
             promote |= ui.small_button("Use as reference").on_hover_text(hint).clicked();
-            if count > 1 {
-                let hint = "Show another pane's image right of a divider you drag";
-                ui.menu_button("Wipe", |ui| wipe_menu_ui(ui, wipe, index, count)).response.on_hover_text(hint);
-            }
+            let hint = "Show another pane's image, or the reference, right of a divider you drag";
+            ui.menu_button("Wipe", |ui| wipe_menu_ui(ui, wipe, index, count)).response.on_hover_text(hint);
             if pane.has_strategies() {
                 let open = pane.strategy_view_mut().open;
                 let hint = "What each way of joining light and camera paths brings to this pane, from the next pass";
@@ -263,7 +269,11 @@ impl Panes {
         let reference = reference.map(|r| &r.image);
         let wipe = match (wipe.as_mut(), other_texture) {
             (Some(wipe), Some(texture)) => {
-                let names = [format!("pane {}", index + 1), format!("pane {}", wipe.other + 1)];
+                let other = match wipe.other {
+                    Against::Pane(other) => format!("pane {}", other + 1),
+                    Against::Reference => "reference".to_string(),
+                };
+                let names = [format!("pane {}", index + 1), other];
                 Some((wipe, texture, names))
             }
             _ => None,
@@ -294,9 +304,12 @@ fn wipe_menu_ui(ui: &mut egui::Ui, wipe: &mut Option<Wipe>, index: usize, count:
         *wipe = None;
         ui.close();
     }
-    for other in (0..count).filter(|&other| other != index) {
+    let others = (0..count)
+        .filter(|&other| other != index)
+        .map(|other| (Against::Pane(other), format!("with pane {}", other + 1)));
+    for (other, label) in others.chain([(Against::Reference, "with the reference".to_string())]) {
         let on = wipe.is_some_and(|w| w.other == other);
-        if ui.selectable_label(on, format!("with pane {}", other + 1)).clicked() {
+        if ui.selectable_label(on, label).clicked() {
             *wipe = Some(Wipe::new(other));
             ui.close();
         }

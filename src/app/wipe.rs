@@ -1,24 +1,32 @@
-//! An A/B wipe: a pane shows another pane's image right of a divider the
-//! user drags, the same part of the scene on both sides (the shared
-//! `ImageView`), so a difference is seen where it is.
+//! An A/B wipe: a pane shows another pane's image, or the reference, right
+//! of a divider the user drags, the same part of the scene on both sides
+//! (the shared `ImageView`), so a difference is seen where it is.
 
 use eframe::egui;
 
 use super::image_view::ImageView;
+use crate::analysis::reference::Reference;
 
 /// Half the width of the divider's handle, in screen points.
 const HANDLE: f32 = 8.0;
 
+/// What a wipe shows right of its divider.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Against {
+    Pane(usize),
+    Reference,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Wipe {
-    /// The pane shown right of the divider.
-    pub other: usize,
+    /// What is shown right of the divider.
+    pub other: Against,
     /// Where the divider stands, as a fraction of the pane's width.
     pub divider: f32,
 }
 
 impl Wipe {
-    pub fn new(other: usize) -> Self {
+    pub fn new(other: Against) -> Self {
         Wipe { other, divider: 0.5 }
     }
 
@@ -74,6 +82,41 @@ pub fn wipe_ui(
     }
 }
 
+/// The reference tone-mapped for each pane that wipes against it (at that
+/// pane's exposure), uploaded again only when the reference or the
+/// exposure changed.
+#[derive(Default)]
+pub struct ReferenceTextures {
+    /// Per pane: what the texture shows (size, samples, seconds, exposure) and it.
+    shown: Vec<Option<(ReferenceKey, egui::TextureHandle)>>,
+}
+
+type ReferenceKey = (u32, u32, u32, u64, u32);
+
+impl ReferenceTextures {
+    pub fn texture(
+        &mut self,
+        ctx: &egui::Context,
+        pane: usize,
+        reference: &Reference,
+        exposure: f32,
+    ) -> egui::TextureId {
+        let image = &reference.image;
+        let info = &reference.info;
+        let key = (image.width, image.height, info.samples_per_pixel, info.seconds.to_bits(), exposure.to_bits());
+        if self.shown.len() <= pane {
+            self.shown.resize_with(pane + 1, || None);
+        }
+        let slot = &mut self.shown[pane];
+        if slot.as_ref().is_none_or(|(shown, _)| *shown != key) {
+            let size = [image.width as usize, image.height as usize];
+            let rgba = egui::ColorImage::from_rgba_unmultiplied(size, &image.to_rgba8(exposure));
+            *slot = Some((key, ctx.load_texture("reference", rgba, egui::TextureOptions::LINEAR)));
+        }
+        slot.as_ref().map_or(egui::TextureId::default(), |(_, texture)| texture.id())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -84,7 +127,7 @@ mod tests {
     #[test]
     fn the_divider_decides_which_image_each_point_shows() {
         let rect = egui::Rect::from_min_size(egui::pos2(100.0, 20.0), egui::vec2(400.0, 300.0));
-        let mut wipe = Wipe::new(1);
+        let mut wipe = Wipe::new(Against::Pane(1));
         let (left, right) = wipe.split(rect);
         assert_eq!((left.max.x, right.min.x), (300.0, 300.0));
         assert_eq!(left.union(right), rect);
