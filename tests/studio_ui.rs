@@ -908,3 +908,33 @@ fn a_wipe_divider_follows_the_drag_and_not_the_camera() {
     harness.run_steps(2);
     assert_eq!(harness.state().panes().wipe(0), None);
 }
+
+/// Selecting an object outlines it in every pane: the outline surrounds
+/// where the camera sees its centre; selecting the camera removes it.
+#[test]
+fn the_selected_object_is_outlined_in_every_pane() {
+    let mut harness = studio(2);
+    step_until(&mut harness, |app| app.panes().list().iter().all(|p| p.state().passes() >= 1));
+    assert!(harness.state().panes().outline(0).is_empty(), "an outline with nothing selected");
+    harness.get_by_label("glass ball (sphere)").click();
+    harness.run_steps(3);
+    let centre = match harness.state().scene().objects.iter().find(|o| o.name == "glass ball").map(|o| &o.shape) {
+        Some(Shape::Sphere { center, .. }) => *center,
+        _ => panic!("no glass ball"),
+    };
+    let film = CameraModel::new(&harness.state().scene().camera, 64, 48).project(centre).expect("in view");
+    let seen = egui::vec2(film.x / 64.0, film.y / 48.0);
+    for index in 0..2 {
+        let outline = harness.state().panes().outline(index);
+        assert!(outline.len() > 8, "pane {index}: {} edges", outline.len());
+        let points = || outline.iter().flatten();
+        let (min_x, max_x) = points().fold((f32::MAX, f32::MIN), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)));
+        let (min_y, max_y) = points().fold((f32::MAX, f32::MIN), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+        assert!((min_x..max_x).contains(&seen.x) && (min_y..max_y).contains(&seen.y), "pane {index}: {seen:?} outside");
+        // Not the whole image: the ball covers a part of it
+        assert!(max_x - min_x < 0.6 && max_y - min_y < 0.8, "pane {index}: {min_x}..{max_x} × {min_y}..{max_y}");
+    }
+    harness.get_by_label("Camera").click();
+    harness.run_steps(3);
+    assert!(harness.state().panes().outline(0).is_empty(), "the outline stayed after the selection went");
+}

@@ -16,6 +16,7 @@ mod image_view;
 mod inspector;
 mod keys;
 mod menu;
+mod outline;
 mod pane;
 mod panes;
 mod plots;

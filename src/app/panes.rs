@@ -10,6 +10,7 @@ use eframe::egui;
 use super::document::Document;
 use super::image_view::ImageView;
 use super::inspector::Selection;
+use super::outline::Outline;
 use super::pane::Pane;
 use super::viewport::{viewport_ui, Look};
 use super::wipe::{Against, ReferenceTextures, Wipe};
@@ -31,6 +32,8 @@ pub struct Panes {
     /// Each pane's wipe to another pane's image or the reference, if on.
     wipes: Vec<Option<Wipe>>,
     reference_textures: ReferenceTextures,
+    /// Each pane's outline of the selected object.
+    outlines: Vec<Outline>,
 }
 
 /// The four panes' algorithms at first: the thesis' three and progressive
@@ -65,6 +68,7 @@ impl Panes {
             view: ImageView::default(),
             wipes: Vec::new(),
             reference_textures: ReferenceTextures::default(),
+            outlines: Vec::new(),
         }
     }
 
@@ -197,6 +201,7 @@ impl Panes {
         let origin = ui.min_rect().min;
         self.rects.resize(count, egui::Rect::NOTHING);
         self.wipes.resize(count, None);
+        self.outlines.resize_with(count, Outline::default);
         for (index, wipe) in self.wipes.iter_mut().enumerate() {
             // A wipe to a pane that went away ends
             if wipe.is_some_and(|w| matches!(w.other, Against::Pane(other) if other >= count || other == index)) {
@@ -278,13 +283,25 @@ impl Panes {
             }
             _ => None,
         };
-        let look = Look { view: &mut self.view, shown, reference, wipe };
+        let object = match *selection {
+            Selection::Object(object) => Some(object),
+            _ => None,
+        };
+        let (width, height) = (pane.state().image.width, pane.state().image.height);
+        self.outlines[index].update(document, object, width, height);
+        let outline = &self.outlines[index];
+        let look = Look { view: &mut self.view, shown, reference, wipe, outline };
         (viewport_ui(ui, pane, document, selection, look).rect, promote)
     }
 
     /// Pane `index`'s wipe, if on.
     pub fn wipe(&self, index: usize) -> Option<Wipe> {
         self.wipes.get(index).copied().flatten()
+    }
+
+    /// Pane `index`'s outline of the selected object: its edges, in image fractions.
+    pub fn outline(&self, index: usize) -> &[[egui::Vec2; 2]] {
+        self.outlines.get(index).map_or(&[], |o| o.edges())
     }
 
     /// How the panes show their images.

@@ -10,6 +10,7 @@ use glam::{Quat, Vec3};
 use super::document::Document;
 use super::image_view::{screen_point, ImageView, GRID_FROM, NEAREST_FROM};
 use super::inspector::Selection;
+use super::outline::{outline_ui, Outline};
 use super::pane::Pane;
 use super::readout::{readout_ui, Readout};
 use super::wipe::{wipe_ui, Wipe};
@@ -70,6 +71,8 @@ pub struct Look<'a> {
     pub shown: Option<egui::Vec2>,
     pub reference: Option<&'a LinearImage>,
     pub wipe: Option<(&'a mut Wipe, egui::TextureId, [String; 2])>,
+    /// The selected object's outline in this pane.
+    pub outline: &'a Outline,
 }
 
 /// Draw the pane and apply its interactions: to the document's camera (a
@@ -82,7 +85,7 @@ pub fn viewport_ui(
     selection: &mut Selection,
     look: Look<'_>,
 ) -> egui::Response {
-    let Look { view, shown, reference, wipe } = look;
+    let Look { view, shown, reference, wipe, outline } = look;
     let (width, height) = (pane.state().image.width, pane.state().image.height);
     let available = ui.available_size();
     let scale = (available.x / width as f32).min(available.y / height as f32).max(0.01);
@@ -97,6 +100,7 @@ pub fn viewport_ui(
     if let Some((wipe, other, names)) = wipe {
         wipe_ui(ui, rect, wipe, other, view, names);
     }
+    outline_ui(ui, rect, view, outline);
     let label = pane.label();
     // Painted over the image, and told to screen readers (and tests) too
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, &label));
