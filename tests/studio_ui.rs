@@ -938,3 +938,27 @@ fn the_selected_object_is_outlined_in_every_pane() {
     harness.run_steps(3);
     assert!(harness.state().panes().outline(0).is_empty(), "the outline stayed after the selection went");
 }
+
+/// The difference view compares the chosen pane with the chosen image:
+/// the reference first, then another pane, in either metric, with its scale.
+#[test]
+fn the_difference_view_compares_the_chosen_images() {
+    let mut harness = studio(2);
+    step_until(&mut harness, |app| app.panes().list().iter().all(|p| p.state().passes() >= 1));
+    harness.get_by_label("View").click();
+    harness.run_steps(2);
+    harness.get_by_label("Difference view").click();
+    harness.key_press(egui::Key::Escape);
+    harness.run_steps(3);
+    // The built-in reference is larger than these small panes
+    harness.get_by_label("no reference at this pane's size or a whole fraction of it");
+    harness.get_by_label("as").click();
+    harness.run_steps(2);
+    harness.get_by_label("pane 2's image").click();
+    harness.run_steps(3);
+    harness.get_by_label("pane 1 against pane 2");
+    harness.get_by_label_contains("(relative error, 99th percentile and above)");
+    harness.get_by_label("signed").click();
+    harness.run_steps(3);
+    harness.get_by_label_contains("(luminance, 99th percentile of |a − b|)");
+}

@@ -57,6 +57,7 @@ pub fn menu_bar_ui(ui: &mut egui::Ui, view: &MenuView, commands: &mut Vec<Comman
         });
         ui.menu_button("Help", |ui| {
             ui.label("Drag: orbit · Shift+drag: pan · Scroll: dolly · Click: select");
+            ui.label("Ctrl+scroll: zoom the images · Ctrl+drag: pan them · F: whole images");
             ui.label("Ctrl+Z / Ctrl+Shift+Z: undo / redo · Ctrl+S: save · Ctrl+O: open");
             ui.label("Drop a .ron file on the window to open it.");
             ui.separator();
