@@ -16,7 +16,7 @@ use crate::scene::ValidScene;
 const MASK_WIDTH: u32 = 200;
 
 /// One pane's outline and what it was worked out for.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub struct Outline {
     /// The scene (a new snapshot each valid edit, held so that its address
     /// is not reused), the object and the image size.
@@ -26,6 +26,18 @@ pub struct Outline {
 }
 
 impl Outline {
+    /// Whether it is up to date for `object` in a `width × height` image
+    /// of the document's scene.
+    pub fn is_for(&self, document: &Document, object: Option<usize>, width: u32, height: u32) -> bool {
+        match (&self.key, object, document.valid()) {
+            (Some((shown, o, w, h)), Some(object), Some(scene)) => {
+                Arc::ptr_eq(shown, scene) && (*o, *w, *h) == (object, width, height)
+            }
+            (None, None, _) | (None, _, None) => self.edges.is_empty(),
+            _ => false,
+        }
+    }
+
     /// Up to date for `object` (None: nothing selected) in a `width × height` image.
     pub fn update(&mut self, document: &Document, object: Option<usize>, width: u32, height: u32) {
         let (Some(object), Some(scene)) = (object, document.valid()) else {
@@ -33,10 +45,7 @@ impl Outline {
             self.edges.clear();
             return;
         };
-        let same = |(shown, o, w, h): &(Arc<ValidScene>, usize, u32, u32)| {
-            Arc::ptr_eq(shown, scene) && (*o, *w, *h) == (object, width, height)
-        };
-        if self.key.as_ref().is_some_and(same) {
+        if self.is_for(document, Some(object), width, height) {
             return;
         }
         self.key = Some((scene.clone(), object, width, height));

@@ -288,7 +288,13 @@ impl Panes {
             _ => None,
         };
         let (width, height) = (pane.state().image.width, pane.state().image.height);
-        self.outlines[index].update(document, object, width, height);
+        // Panes of one size share one outline: worked out once, not once a pane
+        if !self.outlines[index].is_for(document, object, width, height) {
+            match (0..index).find(|&i| self.outlines[i].is_for(document, object, width, height)) {
+                Some(same) => self.outlines[index] = self.outlines[same].clone(),
+                None => self.outlines[index].update(document, object, width, height),
+            }
+        }
         let outline = &self.outlines[index];
         let look = Look { view: &mut self.view, shown, reference, wipe, outline };
         (viewport_ui(ui, pane, document, selection, look).rect, promote)
