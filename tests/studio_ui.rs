@@ -962,3 +962,50 @@ fn the_difference_view_compares_the_chosen_images() {
     harness.run_steps(3);
     harness.get_by_label_contains("(luminance, 99th percentile of |a − b|)");
 }
+
+/// A point light shows as a handle in every pane: a click selects it, a
+/// drag moves it across the view at its depth, one undo step.
+#[test]
+fn a_light_handle_selects_and_moves_its_light() {
+    let mut harness = studio(2);
+    harness.run_steps(2);
+    harness.state_mut().edit_scene(|scene| {
+        scene.lights.push(gi_studio::scene::Light {
+            name: "bulb".into(),
+            kind: gi_studio::scene::LightKind::Point { position: glam::Vec3::new(0.2, 1.4, 0.0) },
+            color: glam::Vec3::ONE,
+            intensity: 1.0,
+            attenuation: gi_studio::scene::Attenuation::default(),
+            enabled: true,
+        })
+    });
+    harness.run_steps(3);
+    let index = harness.state().scene().lights.len() - 1;
+    assert_eq!(harness.query_all_by_label("light bulb").count(), 2, "one handle a pane");
+    harness.get_all_by_label("light bulb").next().expect("a handle").click();
+    harness.run_steps(2);
+    assert_eq!(harness.state().selection(), Selection::Light(index));
+    let before = harness.state().scene().clone();
+    let at = harness.get_all_by_label("light bulb").next().expect("a handle").rect().center();
+    harness.hover_at(at);
+    harness.run_steps(1);
+    harness.drag_at(at);
+    harness.run_steps(1);
+    for step in 1..=4 {
+        harness.hover_at(at + egui::vec2(5.0 * step as f32, 0.0));
+        harness.run_steps(1);
+    }
+    harness.drop_at(at + egui::vec2(20.0, 0.0));
+    harness.run_steps(2);
+    let position = |scene: &gi_studio::scene::Scene| match scene.lights[index].kind {
+        gi_studio::scene::LightKind::Point { position } => position,
+        _ => panic!("not a point light"),
+    };
+    let moved = position(harness.state().scene()) - position(&before);
+    // The camera looks down −z with y up: right is +x; the view does not move
+    assert!(moved.x > 0.01 && moved.y.abs() < 1e-4 && moved.z.abs() < 1e-4, "moved {moved}");
+    assert_eq!(harness.state().scene().camera, before.camera, "dragging the light moved the camera");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(*harness.state().scene(), before, "one undo takes back the drag");
+}

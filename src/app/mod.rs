@@ -11,6 +11,7 @@ mod difference;
 mod document;
 mod export;
 mod files;
+mod handles;
 mod history;
 mod image_view;
 mod inspector;

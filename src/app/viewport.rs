@@ -8,6 +8,7 @@ use eframe::egui;
 use glam::{Quat, Vec3};
 
 use super::document::Document;
+use super::handles::light_handles_ui;
 use super::image_view::{screen_point, ImageView, GRID_FROM, NEAREST_FROM};
 use super::inspector::Selection;
 use super::outline::{outline_ui, Outline};
@@ -101,6 +102,7 @@ pub fn viewport_ui(
         wipe_ui(ui, rect, wipe, other, view, names);
     }
     outline_ui(ui, rect, view, outline);
+    light_handles_ui(ui, rect, view, (width, height), document, selection);
     let label = pane.label();
     // Painted over the image, and told to screen readers (and tests) too
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, &label));
