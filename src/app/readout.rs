@@ -98,14 +98,14 @@ fn area_mean(image: &LinearImage, width: u32, height: u32, (x, y): (u32, u32)) -
 }
 
 /// The read-out drawn over the bottom right of a pane's image in `rect`
-/// (the pane's label is at the top).
+/// (the pane's label is at the top), in a small type and unwrapped, so it
+/// keeps to a corner of a small pane.
 pub fn readout_ui(ui: &mut egui::Ui, rect: egui::Rect, readout: &Readout) {
-    let text = egui::RichText::new(readout.text()).monospace().color(egui::Color32::WHITE);
-    let area = egui::Rect::from_min_max(egui::pos2(rect.center().x, rect.min.y), rect.max).shrink(4.0);
+    let text = egui::RichText::new(readout.text()).monospace().size(10.5).color(egui::Color32::WHITE);
     let layout = egui::Layout::bottom_up(egui::Align::Max);
-    let mut child = ui.new_child(egui::UiBuilder::new().max_rect(area).layout(layout));
-    egui::Frame::new().fill(egui::Color32::from_black_alpha(180)).inner_margin(4.0).show(&mut child, |ui| {
-        ui.add(egui::Label::new(text).selectable(false));
+    let mut child = ui.new_child(egui::UiBuilder::new().max_rect(rect.shrink(4.0)).layout(layout));
+    egui::Frame::new().fill(egui::Color32::from_black_alpha(180)).inner_margin(3.0).show(&mut child, |ui| {
+        ui.add(egui::Label::new(text).selectable(false).extend());
     });
 }
 
