@@ -29,11 +29,12 @@ impl Outline {
     /// Whether it is up to date for `object` in a `width × height` image
     /// of the document's scene.
     pub fn is_for(&self, document: &Document, object: Option<usize>, width: u32, height: u32) -> bool {
-        match (&self.key, object, document.valid()) {
-            (Some((shown, o, w, h)), Some(object), Some(scene)) => {
+        match (&self.key, object.zip(document.valid())) {
+            (Some((shown, o, w, h)), Some((object, scene))) => {
                 Arc::ptr_eq(shown, scene) && (*o, *w, *h) == (object, width, height)
             }
-            (None, None, _) | (None, _, None) => self.edges.is_empty(),
+            // Nothing to outline, and nothing outlined
+            (None, None) => true,
             _ => false,
         }
     }

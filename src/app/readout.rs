@@ -86,15 +86,7 @@ fn area_mean(image: &LinearImage, width: u32, height: u32, (x, y): (u32, u32)) -
     if factor == 0 || image.width != width * factor || image.height != height * factor {
         return None;
     }
-    let mut sum = [0.0f64; 3];
-    for dy in 0..factor {
-        for dx in 0..factor {
-            let p = image.get(x * factor + dx, y * factor + dy);
-            (0..3).for_each(|c| sum[c] += p[c] as f64);
-        }
-    }
-    let weight = 1.0 / (factor * factor) as f64;
-    Some(sum.map(|s| (s * weight) as f32))
+    Some(image.block_mean(x, y, factor))
 }
 
 /// The read-out drawn over the bottom right of a pane's image in `rect`

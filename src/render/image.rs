@@ -206,20 +206,26 @@ impl LinearImage {
         let factor = factor.max(1);
         let (width, height) = (self.width / factor, self.height / factor);
         let mut out = LinearImage::new(width, height);
-        let weight = 1.0 / (factor * factor) as f64;
         for y in 0..height {
             for x in 0..width {
-                let mut sum = [0.0f64; 3];
-                for dy in 0..factor {
-                    for dx in 0..factor {
-                        let p = self.get(x * factor + dx, y * factor + dy);
-                        (0..3).for_each(|c| sum[c] += p[c] as f64);
-                    }
-                }
-                out.pixels[(y * width + x) as usize] = sum.map(|s| (s * weight) as f32);
+                out.pixels[(y * width + x) as usize] = self.block_mean(x, y, factor);
             }
         }
         out
+    }
+
+    /// The mean of the `factor × factor` block at block (x, y): pixel (x, y)
+    /// of `downsample(factor)`.
+    pub fn block_mean(&self, x: u32, y: u32, factor: u32) -> [f32; 3] {
+        let mut sum = [0.0f64; 3];
+        for dy in 0..factor {
+            for dx in 0..factor {
+                let p = self.get(x * factor + dx, y * factor + dy);
+                (0..3).for_each(|c| sum[c] += p[c] as f64);
+            }
+        }
+        let weight = 1.0 / (factor * factor) as f64;
+        sum.map(|s| (s * weight) as f32)
     }
 
     /// This image at `width × height` if that divides it evenly (itself when

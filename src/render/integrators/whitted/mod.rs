@@ -19,10 +19,11 @@ use crate::geometry::Ray;
 use crate::render::integrators::Counters;
 use crate::render::world::camera::CameraTile;
 use crate::render::world::light::LightSource;
+use crate::render::world::materials::Bsdf;
 use crate::render::world::rng::Sampler;
 use crate::render::world::World;
 use crate::scene::Rgb;
-use shading::{branches, combine, light_term, lit_cosine, shades};
+use shading::{branches, combine, light_term, lit_cosine};
 
 /// Whitted ray tracing: at most `rays` rays in a chain through mirrors and
 /// glass, each hit lit by shadow rays.
@@ -77,16 +78,17 @@ fn trace(
     let Some(hit) = scope.intersect(ray) else {
         return world.background;
     };
-    let material = world.material_of(&hit);
+    // The material once a hit, not once a light
+    let bsdf = Bsdf::new(world.material_of(&hit));
     let mut local = Rgb::ZERO;
-    if shades(material) {
+    if bsdf.thesis_lit() {
         let at = shading::at(ray, &hit);
         let n = at.facing.into();
         // The background is seen by rays that escape, not as a local light
         for light in world.lights.iter().filter(|l| !matches!(l, LightSource::Background { .. })) {
             let lit = |sample: &_| lit_cosine(n, sample);
             if let Some((sample, cos)) = scope.light_sample(light, &hit, sampler.next_2d(), counters, lit) {
-                local += light_term(material, &at, &sample, cos);
+                local += light_term(&bsdf, &at, &sample, cos);
             }
         }
     }

@@ -12,7 +12,7 @@ use crate::geometry::Ray;
 use crate::render::world::light::LightSample;
 use crate::render::world::materials::{reflect, At, Brought, Bsdf};
 use crate::render::world::{Hit, World};
-use crate::scene::{MaterialModel, Rgb};
+use crate::scene::Rgb;
 
 /// Below this path weight a reflection adds nothing visible.
 const MIN_WEIGHT: f32 = 1e-3;
@@ -29,13 +29,6 @@ pub struct Branches {
 #[inline]
 pub fn at(ray: &Ray, hit: &Hit) -> At<f32> {
     At::new(-ray.direction, hit.surface.normal)
-}
-
-/// Whether the local model is lit at this material (and so draws a light
-/// sample per light).
-#[inline]
-pub fn shades(material: &MaterialModel) -> bool {
-    Bsdf::new(material).thesis_lit()
 }
 
 /// The rays `ray`'s hit spawns, `depth_left` levels left, its light
@@ -55,10 +48,10 @@ pub fn branches(world: &World, ray: &Ray, hit: &Hit, depth_left: u32, weight: f3
 
 /// The local model toward one light sample at cosine `cos`, the light's
 /// colour its irradiance over π (the thesis' `Ld`). Zero where the
-/// material is not lit.
-pub fn light_term(material: &MaterialModel, at: &At<f32>, sample: &LightSample, cos: f32) -> Rgb {
+/// material is not lit (`Bsdf::thesis_lit`).
+pub fn light_term(bsdf: &Bsdf, at: &At<f32>, sample: &LightSample, cos: f32) -> Rgb {
     let light_colour = sample.value * FRAC_1_PI;
-    light_colour * Bsdf::new(material).thesis_local(at, sample.wi, cos)
+    light_colour * bsdf.thesis_local(at, sample.wi, cos)
 }
 
 /// A light sample's cosine at the lit point, where it can light it (a NaN

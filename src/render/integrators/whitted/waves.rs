@@ -7,7 +7,7 @@
 //! time, and each pixel's tree is summed from its leaves as the recursion
 //! sums it: the same light, bit for bit (`radiance`).
 
-use super::shading::{branches, combine, light_term, lit_cosine, shades, Branches};
+use super::shading::{branches, combine, light_term, lit_cosine, Branches};
 use crate::geometry::Ray;
 use crate::render::integrators::flying;
 use crate::render::integrators::next_event::PathScope;
@@ -16,6 +16,7 @@ use crate::render::integrators::Counters;
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lane_world::LaneWorld;
 use crate::render::world::light::LightSource;
+use crate::render::world::materials::Bsdf;
 use crate::render::world::occluders::Shadow;
 use crate::render::world::{Hit, World};
 use crate::scene::Rgb;
@@ -122,8 +123,9 @@ pub fn render_tile(
             stack.extend(second);
             stack.extend(first);
             let Some(hit) = n.hit else { continue };
-            let material = world.material_of(&hit);
-            if !shades(material) {
+            // The material once a hit, not once a light
+            let bsdf = Bsdf::new(world.material_of(&hit));
+            if !bsdf.thesis_lit() {
                 continue;
             }
             let at = super::shading::at(&n.ray, &hit);
@@ -136,7 +138,7 @@ pub fn render_tile(
                     scope.unshadowed_light_sample(light, &hit, sampler.next_2d(), counters, lit)
                 {
                     let shadow = shadows.push(Shadow::toward(&sample, scope.held));
-                    terms.push(Term { value: light_term(material, &at, &sample, cos), shadow });
+                    terms.push(Term { value: light_term(&bsdf, &at, &sample, cos), shadow });
                 }
             }
             nodes[node as usize].terms = (first, terms.len() as u32 - first);
