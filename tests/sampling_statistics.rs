@@ -131,7 +131,7 @@ fn light_pdf_toward(light: &LightSource, world: &World, at: Vec3, d: Vec3) -> f6
     let ray = Ray::new(at, d);
     let hit = match world.objects[*object as usize].shape {
         gi_studio::render::world::ShapeRef::Sphere(i) => {
-            intersect_sphere(&ray, world.spheres.center(i as usize), world.spheres.radius[i as usize], f32::INFINITY)
+            intersect_sphere(&ray, world.spheres.center(i as usize), world.spheres.radius(i as usize), f32::INFINITY)
         }
         gi_studio::render::world::ShapeRef::Triangle(t) => {
             intersect_triangle(&ray, &world.triangles[t as usize].0, f32::INFINITY)

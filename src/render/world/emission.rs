@@ -10,9 +10,9 @@ use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
 
-use super::light::{spot_factor, Emitter, LightSource};
+use super::light::{spot_factor, LightSource};
+use super::sampling::uniform_sphere_pdf;
 use super::sampling::{cosine_hemisphere, uniform_cone, uniform_cone_pdf, uniform_sphere};
-use super::sampling::{uniform_sphere_pdf, uniform_triangle};
 use crate::geometry::{offset_ray_origin, pow, Frame, Ray, SurfaceHit};
 use crate::scene::Rgb;
 
@@ -187,7 +187,7 @@ impl LightSource {
                 }
             }
             LightSource::Area { radiance, ref emitter, .. } => {
-                let (point, normal, error) = point_on_emitter(emitter, u1);
+                let (point, normal, error) = emitter.uniform_point(u1);
                 let local = cosine_hemisphere(u2);
                 let d = Frame::from_z(normal).to_world(local);
                 // Cosine-weighted: L cos θ / (pdf_area · cos θ/π) = π L A
@@ -244,23 +244,6 @@ impl LightSource {
                 let hit = SurfaceHit { t: distance2.sqrt(), point: on_light, normal, error: 0.0 };
                 self.pdf(receiver, &hit) * cos.max(0.0) / distance2
             }
-        }
-    }
-}
-
-/// A uniform point on an emitter: (point, normal, error bound).
-pub fn point_on_emitter(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f32) {
-    match *emitter {
-        Emitter::Sphere { center, radius, cap, .. } => {
-            // Uniform over the emitting cap (the whole sphere when 1 − cos = 2)
-            let normal =
-                if cap.is_whole() { uniform_sphere(u) } else { cap.frame.to_world(uniform_cone(u, cap.one_minus_cos)) };
-            (center + normal * radius, normal, emitter.error())
-        }
-        Emitter::Triangle { shape: ref triangle, .. } => {
-            let (b0, b1) = uniform_triangle(u);
-            let [a, b, c] = triangle.vertices;
-            (a * b0 + b * b1 + c * (1.0 - b0 - b1), triangle.normal, emitter.error())
         }
     }
 }

@@ -12,8 +12,6 @@ pub mod occluders;
 pub mod rng;
 pub mod sampling;
 pub mod shapes;
-pub mod spheres;
-pub mod triangles;
 
 use glam::Vec3;
 
@@ -23,11 +21,11 @@ use crate::geometry::{plane_exit_t, plane_hit, plane_t, sphere_hit};
 use crate::geometry::{Ray, SurfaceHit, Triangle};
 use crate::scene::{LightKind, MaterialModel, Rgb, Shape, ValidScene};
 use camera::CameraModel;
-use light::{Emitter, EmitterCap, LightSource};
+use light::{Emitter, LightSource};
 use occluders::{Occluders, Shadow, WallPlane, Walls};
+use shapes::sphere::Sphere;
+use shapes::{CappedSphere, EmitterCap, SphereLanes, TriangleLanes};
 pub use shapes::{ObjectInfo, PlaneShape, ShapeRef, Spheres};
-use spheres::SphereLanes;
-use triangles::TriangleLanes;
 
 /// What `intersect_held` found nearest.
 /// What `World::reach` gives a ray to meet.
@@ -152,20 +150,16 @@ impl World {
             light_plane: Vec::new(),
         };
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        let mut spheres = Vec::new();
         for (index, object) in scene.objects.iter().enumerate() {
             let id = index as u32;
             let material = scene.material_index(&object.material).unwrap_or(0) as u32;
             let shape = match &object.shape {
                 Shape::Sphere { center, radius } => {
-                    let s = &mut world.spheres;
-                    s.center_x.push(center.x);
-                    s.center_y.push(center.y);
-                    s.center_z.push(center.z);
-                    s.radius.push(*radius);
-                    s.object.push(id);
+                    spheres.push(Sphere { center: *center, radius: *radius, object: id });
                     lo = lo.min(*center - *radius);
                     hi = hi.max(*center + *radius);
-                    ShapeRef::Sphere(s.radius.len() as u32 - 1)
+                    ShapeRef::Sphere(spheres.len() as u32 - 1)
                 }
                 Shape::Plane { point, normal } => {
                     let normal = normal.normalize();
@@ -181,9 +175,7 @@ impl World {
             };
             world.objects.push(ObjectInfo { shape, material, light: None });
         }
-        let centers: Vec<Vec3> = (0..world.spheres.radius.len()).map(|i| world.spheres.center(i)).collect();
-        let ids = (0..centers.len() as u32).collect();
-        world.spheres.lanes = SphereLanes::new(&centers, &world.spheres.radius, ids);
+        world.spheres = Spheres::new(spheres);
         Triangle::share_planes(&mut world.triangles.iter_mut().map(|(triangle, _)| triangle).collect::<Vec<_>>());
         world.triangle_lanes = TriangleLanes::new(&world.triangles);
         if lo.x <= hi.x {
@@ -223,12 +215,13 @@ impl World {
                 };
                 if sampled && radiance.max_element() > 0.0 {
                     let emitter = match info.shape {
-                        ShapeRef::Sphere(i) => Emitter::Sphere {
-                            sphere: i,
-                            center: world.spheres.center(i as usize),
-                            radius: world.spheres.radius[i as usize],
-                            cap: EmitterCap::WHOLE,
-                        },
+                        ShapeRef::Sphere(i) => {
+                            let Sphere { center, radius, .. } = world.spheres.list[i as usize];
+                            Emitter::Sphere {
+                                sphere: i,
+                                shape: CappedSphere { center, radius, cap: EmitterCap::WHOLE },
+                            }
+                        }
                         ShapeRef::Triangle(t) => {
                             Emitter::Triangle { triangle: t, shape: world.triangles[t as usize].0 }
                         }
@@ -348,15 +341,15 @@ impl World {
         }
         let (surface, object) = match best? {
             Inside::Sphere(i, near) => {
-                let i = i as usize;
-                (sphere_hit(ray, s.center(i), s.radius[i], best_t, near), s.object[i])
+                let Sphere { center, radius, object } = s.list[i as usize];
+                (sphere_hit(ray, center, radius, best_t, near), object)
             }
             Inside::Wall(k) => {
                 let (i, wall) = &reach.wall_spheres[k];
                 let center = V3::from(s.center(*i as usize));
                 let (point, normal, error) = wall_exit_hit(origin, direction, best_t, center, wall_slack(wall));
                 let surface = SurfaceHit { t: best_t, point: point.into(), normal: normal.into(), error };
-                (surface, s.object[*i as usize])
+                (surface, s.list[*i as usize].object)
             }
             Inside::Plane(plane) => (plane_hit(ray, plane.normal, plane.offset, best_t), plane.object),
             Inside::Triangle(i) => (triangle_hit?.1, self.triangles[i as usize].1),
@@ -443,8 +436,8 @@ impl World {
     fn fit_caps(&mut self, eye: Option<Vec3>) {
         let caps = self.emitter_caps(eye);
         for light in &mut self.lights {
-            if let LightSource::Area { emitter: Emitter::Sphere { sphere, cap, .. }, .. } = light {
-                *cap = caps[*sphere as usize];
+            if let LightSource::Area { emitter: Emitter::Sphere { sphere, shape }, .. } = light {
+                shape.cap = caps[*sphere as usize];
             }
         }
     }
@@ -463,12 +456,12 @@ impl World {
     ///   BSDF sampling).
     fn emitter_caps(&self, eye: Option<Vec3>) -> Vec<EmitterCap> {
         let s = &self.spheres;
-        let count = s.radius.len();
-        let material = |i: usize| &self.materials[self.objects[s.object[i] as usize].material as usize];
+        let count = s.len();
+        let material = |i: usize| &self.materials[self.objects[s.list[i].object as usize].material as usize];
         let enclosing: Vec<usize> = match eye {
             Some(eye) => (0..count)
                 .filter(|&j| !matches!(material(j), MaterialModel::Glass { .. }))
-                .filter(|&j| (eye.as_dvec3() - s.center(j).as_dvec3()).length() <= s.radius[j] as f64 * (1.0 - 1e-6))
+                .filter(|&j| (eye.as_dvec3() - s.center(j).as_dvec3()).length() <= s.radius(j) as f64 * (1.0 - 1e-6))
                 .collect(),
             None => Vec::new(),
         };
@@ -491,10 +484,10 @@ impl World {
                 if !matches!(material(i), MaterialModel::Emissive { .. }) {
                     return EmitterCap::WHOLE;
                 }
-                let (center, radius) = (s.center(i), s.radius[i]);
+                let Sphere { center, radius, .. } = s.list[i];
                 let in_spheres = (enclosing.iter().filter(|&&j| j != i)).map(|&j| EmitterCap {
-                    wall: Some(s.object[j]),
-                    ..EmitterCap::inside(center, radius, s.center(j), s.radius[j])
+                    wall: Some(s.list[j].object),
+                    ..EmitterCap::inside(center, radius, s.center(j), s.radius(j))
                 });
                 let in_half_spaces = sides.iter().map(|&(inward, offset, object)| EmitterCap {
                     wall: Some(object),

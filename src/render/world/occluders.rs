@@ -13,9 +13,7 @@ use glam::{DVec3, Vec3};
 
 use super::lanes::{F8, M8, V8};
 use super::light::{Emitter, LightSample, LightSource};
-use super::shapes::{PlaneShape, Spheres};
-use super::spheres::SphereLanes;
-use super::triangles::TriangleLanes;
+use super::shapes::{PlaneShape, SphereLanes, Spheres, TriangleLanes};
 use crate::geometry::sphere::AnchoredSphere;
 use crate::geometry::{gamma, plane_t};
 use crate::geometry::{Ray, Triangle};
@@ -136,12 +134,12 @@ impl Walls {
         };
         let s = spheres;
         let (mut regions, mut others, mut wall_spheres) = (Vec::new(), Vec::new(), Vec::new());
-        for j in 0..s.radius.len() {
-            let region = Region::ball(s.center(j), s.radius[j]);
-            let wall = is_wall(&region, s.object[j]);
+        for (j, sphere) in s.list.iter().enumerate() {
+            let region = Region::ball(sphere.center, sphere.radius);
+            let wall = is_wall(&region, sphere.object);
             if wall {
                 regions.push(region);
-                wall_spheres.push((j as u32, AnchoredSphere::new(s.center(j), s.radius[j], eye_f32)));
+                wall_spheres.push((j as u32, AnchoredSphere::new(sphere.center, sphere.radius, eye_f32)));
             } else {
                 others.push(j);
             }
@@ -164,7 +162,7 @@ impl Walls {
             return Walls::default();
         }
         let centers: Vec<Vec3> = others.iter().map(|&j| s.center(j)).collect();
-        let radii: Vec<f32> = others.iter().map(|&j| s.radius[j]).collect();
+        let radii: Vec<f32> = others.iter().map(|&j| s.radius(j)).collect();
         let ids = others.iter().map(|&j| j as u32).collect();
         Walls {
             regions,
@@ -229,22 +227,9 @@ fn holds_samples(light: &LightSource, region: &Region, object: u32) -> bool {
         }
         LightSource::Directional { .. } | LightSource::Background { .. } => false,
         LightSource::Area { ref emitter, .. } => match *emitter {
-            Emitter::Sphere { center, radius, cap, .. } => {
-                if cap.wall == Some(object) {
-                    // Cut to this wall's inside: in it by construction
-                    return true;
-                }
-                let (c, r) = (center.as_dvec3(), radius as f64);
-                let cos_min = 1.0 - cap.one_minus_cos as f64;
-                if cos_min > 0.0 {
-                    // The ball on the cap's rim circle holds the cap
-                    let rim_center = c + cap.frame.z.as_dvec3() * (r * cos_min);
-                    region.holds(rim_center, r * (1.0 - cos_min * cos_min).sqrt() * (1.0 + 1e-6))
-                } else {
-                    region.holds(c, r)
-                }
-            }
-            Emitter::Triangle { ref shape, .. } => shape.vertices.iter().all(|v| region.holds(v.as_dvec3(), 0.0)),
+            // Cut to this wall's inside: in it by construction
+            Emitter::Sphere { shape, .. } if shape.cap.wall == Some(object) => true,
+            _ => emitter.held_by(&|center, reach| region.holds(center, reach)),
         },
     }
 }
@@ -546,7 +531,7 @@ mod tests {
                             })
                         });
                         let own_sphere = sample.on_sphere.is_some_and(|i| {
-                            sphere_t(shadow, w.spheres.center(i as usize), w.spheres.radius[i as usize], t_max)
+                            sphere_t(shadow, w.spheres.center(i as usize), w.spheres.radius(i as usize), t_max)
                                 .is_some()
                         });
                         let target = shadow.origin.as_dvec3() + shadow.direction.as_dvec3() * t_max as f64;

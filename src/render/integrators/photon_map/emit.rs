@@ -9,7 +9,6 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use crate::geometry::{offset_ray_origin, Frame, Ray};
-use crate::render::world::emission::point_on_emitter;
 use crate::render::world::light::{spot_factor, LightSource};
 use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::{uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_sphere_pdf};
@@ -93,7 +92,7 @@ pub fn specular_targets(world: &World) -> Vec<(Vec3, f32)> {
         .filter(|o| crate::render::world::materials::Bsdf::new(&world.materials[o.material as usize]).is_specular())
         .filter(|o| !matches!(world.materials[o.material as usize], crate::scene::MaterialModel::Emissive { .. }))
         .filter_map(|o| match o.shape {
-            ShapeRef::Sphere(i) => Some((world.spheres.center(i as usize), world.spheres.radius[i as usize])),
+            ShapeRef::Sphere(i) => Some((world.spheres.center(i as usize), world.spheres.radius(i as usize))),
             ShapeRef::Triangle(t) => {
                 let [a, b, c] = world.triangles[t as usize].0.vertices;
                 let center = (a + b + c) / 3.0;
@@ -192,7 +191,7 @@ pub fn emit_toward(
             (Ray::new(origin, direction), radiance / (uniform_sphere_pdf() * density))
         }
         LightSource::Area { radiance, ref emitter, .. } => {
-            let (point, normal, error) = point_on_emitter(emitter, u1);
+            let (point, normal, error) = emitter.uniform_point(u1);
             let d = cone_direction(point)?;
             let cos = normal.dot(d);
             if cos <= 0.0 {

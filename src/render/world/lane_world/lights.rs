@@ -8,9 +8,11 @@ use glam::{Vec2, Vec3};
 
 use crate::geometry::{frame_from_z, offset_origin, ray_to, to_world, SurfaceHit};
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
-use crate::render::world::light::{solid_angle_pdf_of, sphere_cone_normal_of, triangle_point_of, Emitter, LightSource};
+use crate::render::world::light::{Emitter, LightSource};
 use crate::render::world::sampling::{cosine_hemisphere_of, uniform_cone_of, uniform_cone_pdf_of};
 use crate::render::world::sampling::{uniform_sphere_of, uniform_triangle_of};
+use crate::render::world::shapes::sphere::{sphere_cone_normal_of, CappedSphere};
+use crate::render::world::shapes::{solid_angle_pdf_of, triangle::triangle_point_of};
 use crate::render::world::World;
 use crate::scene::{Attenuation, Rgb};
 
@@ -99,10 +101,10 @@ impl LaneLight {
         };
         let (error, area) = (emitter.error(), emitter.area());
         Some(match emitter {
-            Emitter::Sphere { center, radius, cap, .. } if cap.is_whole() => {
+            Emitter::Sphere { shape: CappedSphere { center, radius, cap }, .. } if cap.is_whole() => {
                 LaneLight::Sphere(SphereLight { center, radius, error, area, radiance })
             }
-            Emitter::Sphere { center, radius, cap, .. } => LaneLight::Cap(CapLight {
+            Emitter::Sphere { shape: CappedSphere { center, radius, cap }, .. } => LaneLight::Cap(CapLight {
                 center,
                 radius,
                 error,

@@ -33,10 +33,11 @@ pub(crate) use shadows::Skips;
 use wall_exits::WallExits;
 
 use crate::geometry::sphere::{wall_slack, AnchoredSphere};
-use crate::geometry::{gamma, Triangle};
+use crate::geometry::Triangle;
 use crate::render::world::lanes::{self, Column, Column3, Index8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSource};
 pub(crate) use crate::render::world::materials::lanes::{LaneSurfaces, MaterialTable, Scattered};
+use crate::render::world::shapes::sphere::Sphere;
 use crate::render::world::{ShapeRef, World};
 use crate::scene::Rgb;
 
@@ -67,16 +68,16 @@ struct SphereColumns {
 }
 
 impl SphereColumns {
-    /// For `spheres`, of radii `radii`.
-    fn new(spheres: &[SphereInfo], radii: &[f32]) -> Self {
+    /// For `spheres`, the world's `list` as the hit loop meets them.
+    fn new(spheres: &[SphereInfo], list: &[Sphere]) -> Self {
         let column = |field: &dyn Fn(&SphereInfo, f32) -> f32| {
-            Column::new(spheres.iter().zip(radii).map(|(sphere, &radius)| field(sphere, radius)))
+            Column::new(spheres.iter().zip(list).map(|(sphere, s)| field(sphere, s.radius)))
         };
         SphereColumns {
             center: Column3::new(spheres.iter().map(|s| s.center)),
             radius: column(&|_, radius| radius),
             wall: column(&|s, _| s.wall.map_or(0.0, |_| 1.0)),
-            error: column(&|s, radius| gamma(6) * (s.center.abs().max_element() + radius)),
+            error: column(&|s, radius| Sphere::error(s.center, radius)),
             wall_slack: column(&|s, _| s.wall.map_or(0.0, |w| wall_slack(&w))),
         }
     }
@@ -160,7 +161,7 @@ impl LaneWorld {
             return None;
         }
         let s = &world.spheres;
-        let objects = s.object.iter().copied();
+        let objects = s.list.iter().map(|sphere| sphere.object);
         let objects = objects.chain(world.planes.iter().map(|p| p.object));
         let objects = objects.chain(world.triangles.iter().map(|(_, object)| *object));
         let surfaces =
@@ -169,10 +170,12 @@ impl LaneWorld {
             return None;
         }
         let wall = |i: usize| world.walls.wall_spheres.iter().find(|(j, _)| *j as usize == i).map(|(_, w)| *w);
-        let spheres: Vec<SphereInfo> = (0..s.radius.len())
-            .map(|i| {
-                let radius = s.radius[i];
-                SphereInfo { center: s.center(i), radius2: radius * radius, shape: i as f32, wall: wall(i) }
+        let spheres: Vec<SphereInfo> = (s.list.iter().enumerate())
+            .map(|(i, sphere)| SphereInfo {
+                center: sphere.center,
+                radius2: sphere.radius * sphere.radius,
+                shape: i as f32,
+                wall: wall(i),
             })
             .collect();
         let planes: Vec<PlaneInfo> = (world.planes.iter())
@@ -215,7 +218,7 @@ impl LaneWorld {
             inner_spheres,
             others: others.into_iter().map(occluder).collect(),
             walls: walls.into_iter().map(occluder).collect(),
-            sphere_columns: SphereColumns::new(&spheres, &s.radius),
+            sphere_columns: SphereColumns::new(&spheres, &s.list),
             spheres,
             plane_normals: Column3::new(by_shape().map(|p| p.map_or(Vec3::ZERO, |p| p.normal))),
             plane_offsets: Column::new(by_shape().map(|p| p.map_or(0.0, |p| p.offset))),

@@ -6,14 +6,18 @@
 //! operation for operation, the rare ray whose edge function is exactly
 //! zero (redone in f64 there) is handed to the scalar test, and hits are
 //! taken in the scalar loop's order.
+//!
+//! A triangle light is sampled uniformly over its area.
 
-use glam::{BVec4A, Vec4};
+use glam::{BVec4A, DVec3, Vec2, Vec3, Vec4};
 
-use crate::geometry::real::V3;
+use super::{solid_angle_pdf, AreaEmitter};
+use crate::geometry::real::{Real, V3};
 use crate::geometry::{
     beyond, edges_of, triangle_hit_of, watertight_finish_of, watertight_range_of, Crossing, RayShear,
 };
-use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
+use crate::geometry::{gamma, intersect_triangle, Ray, SurfaceHit, Triangle};
+use crate::render::world::sampling::uniform_triangle;
 
 /// Four triangles' vertices, planes and edges (`geometry::cull`), lane by
 /// lane.
@@ -202,10 +206,52 @@ impl TriangleLanes {
     }
 }
 
+/// The point of barycentrics (b0, b1, 1 − b0 − b1) on a triangle, for one
+/// point or several.
+#[inline(always)]
+pub fn triangle_point_of<R: Real>([a, b, c]: [V3<R>; 3], b0: R, b1: R) -> V3<R> {
+    a * b0 + b * b1 + c * (R::splat(1.0) - b0 - b1)
+}
+
+impl AreaEmitter for Triangle {
+    fn area(&self) -> f32 {
+        Triangle::area(self)
+    }
+
+    fn emits_at(&self, _point: Vec3) -> bool {
+        true
+    }
+
+    #[inline]
+    fn error(&self) -> f32 {
+        let [a, b, c] = self.vertices;
+        gamma(7) * (a.abs() + b.abs() + c.abs()).max_element()
+    }
+
+    fn uniform_point(&self, u: Vec2) -> (Vec3, Vec3) {
+        let (b0, b1) = uniform_triangle(u);
+        (triangle_point_of(self.vertices.map(V3::from), b0, b1).into(), self.normal)
+    }
+
+    #[inline]
+    fn sample_from(&self, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32)> {
+        let (point, normal) = self.uniform_point(u);
+        let pdf = solid_angle_pdf(p, point, normal, Triangle::area(self));
+        (pdf > 0.0).then_some((point, normal, pdf))
+    }
+
+    #[inline]
+    fn pdf_from(&self, p: Vec3, hit: &SurfaceHit) -> f32 {
+        solid_angle_pdf(p, hit.point, self.normal, Triangle::area(self))
+    }
+
+    fn held_by(&self, holds: &dyn Fn(DVec3, f64) -> bool) -> bool {
+        self.vertices.iter().all(|v| holds(v.as_dvec3(), 0.0))
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use glam::Vec3;
-
     use super::*;
     use crate::geometry::shear_of;
     use crate::render::world::rng::Sampler;
