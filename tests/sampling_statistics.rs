@@ -130,11 +130,14 @@ fn light_pdf_toward(light: &LightSource, world: &World, at: Vec3, d: Vec3) -> f6
     let LightSource::Area { object, .. } = light else { return 0.0 };
     let ray = Ray::new(at, d);
     let hit = match world.objects[*object as usize].shape {
-        gi_studio::render::world::ShapeRef::Sphere(i) => {
-            intersect_sphere(&ray, world.spheres.center(i as usize), world.spheres.radius(i as usize), f32::INFINITY)
-        }
+        gi_studio::render::world::ShapeRef::Sphere(i) => intersect_sphere(
+            &ray,
+            world.shapes.spheres.center(i as usize),
+            world.shapes.spheres.radius(i as usize),
+            f32::INFINITY,
+        ),
         gi_studio::render::world::ShapeRef::Triangle(t) => {
-            intersect_triangle(&ray, &world.triangles[t as usize].0, f32::INFINITY)
+            intersect_triangle(&ray, &world.shapes.triangles[t as usize].0, f32::INFINITY)
         }
         gi_studio::render::world::ShapeRef::Plane(_) => None,
     };

@@ -51,7 +51,7 @@ fn escapes(paths: u64, held: bool) -> u64 {
     let camera = CameraModel::new(&scene.camera, 512, 384);
     let (world, _) = World::for_view(&scene, &camera, 512, 384);
     let walls: Vec<u32> =
-        (world.spheres.list.iter()).filter(|sphere| sphere.radius > 1e4).map(|sphere| sphere.object).collect();
+        (world.shapes.spheres.list.iter()).filter(|sphere| sphere.radius > 1e4).map(|sphere| sphere.object).collect();
     assert_eq!(walls.len(), 6);
     const CHUNK: u64 = 100_000;
     (0..paths.div_ceil(CHUNK))

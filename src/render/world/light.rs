@@ -2,72 +2,14 @@
 //! directional) and emissive spheres and triangles (area lights). Each
 //! carries the geometry it is sampled on, so sampling needs nothing else.
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 
 use super::sampling::{uniform_sphere, uniform_sphere_pdf};
-use super::shapes::{AreaEmitter, CappedSphere, EmitterCap};
+pub use super::shapes::Emitter;
+use super::shapes::EmitterCap;
 use crate::faults::{self, Fault};
-use crate::geometry::{pow, Ray, SurfaceHit, Triangle};
+use crate::geometry::{pow, Ray, SurfaceHit};
 use crate::scene::{Attenuation, Rgb};
-
-/// The surface an area light is sampled on: the shape, with what each
-/// kind answers as a light in its own file (`shapes::AreaEmitter`).
-#[derive(Clone, Copy, Debug)]
-pub enum Emitter {
-    /// Sphere `sphere` of the world, emitting from its cap.
-    Sphere { sphere: u32, shape: CappedSphere },
-    /// Triangle `triangle` of the world.
-    Triangle { triangle: u32, shape: Triangle },
-}
-
-/// `$body` for the emitter's shape, whatever its kind.
-macro_rules! on_shape {
-    ($emitter:expr, $shape:ident => $body:expr) => {
-        match $emitter {
-            Emitter::Sphere { shape: $shape, .. } => $body,
-            Emitter::Triangle { shape: $shape, .. } => $body,
-        }
-    };
-}
-
-impl Emitter {
-    /// The emitting area.
-    pub fn area(&self) -> f32 {
-        on_shape!(self, shape => shape.area())
-    }
-
-    /// Whether `point` (on the emitter) lies where it emits: on a sphere,
-    /// within its cap.
-    pub fn emits_at(&self, point: Vec3) -> bool {
-        on_shape!(self, shape => shape.emits_at(point))
-    }
-
-    /// Bound on the error of points computed on it.
-    #[inline]
-    pub fn error(&self) -> f32 {
-        on_shape!(self, shape => shape.error())
-    }
-
-    /// A point uniform over the emitting area: (point, normal, error bound).
-    pub fn uniform_point(&self, u: Vec2) -> (Vec3, Vec3, f32) {
-        let (point, normal) = on_shape!(self, shape => shape.uniform_point(u));
-        (point, normal, self.error())
-    }
-
-    /// A point on it seen from `p`: (point, outward normal, error bound,
-    /// solid-angle pdf at `p`).
-    #[inline]
-    fn sample_from(&self, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32, f32)> {
-        let (point, normal, pdf) = on_shape!(self, shape => shape.sample_from(p, u))?;
-        Some((point, normal, self.error(), pdf))
-    }
-
-    /// Whether every point it emits from lies in a region
-    /// (`AreaEmitter::held_by`).
-    pub fn held_by(&self, holds: &dyn Fn(DVec3, f64) -> bool) -> bool {
-        on_shape!(self, shape => shape.held_by(holds))
-    }
-}
 
 #[derive(Clone, Debug)]
 pub enum LightSource {
@@ -239,7 +181,7 @@ impl LightSource {
     #[inline]
     fn area_pdf(&self, p: Vec3, hit: &SurfaceHit) -> f32 {
         let LightSource::Area { emitter, .. } = self else { return 0.0 };
-        on_shape!(emitter, shape => shape.pdf_from(p, hit))
+        emitter.pdf_from(p, hit)
     }
 
     /// The emitting sphere's cap, for a light on a sphere.
@@ -254,62 +196,10 @@ impl LightSource {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Frame;
+    use crate::geometry::{Frame, Triangle};
     use crate::render::world::camera::CameraModel;
     use crate::render::world::rng::Sampler;
     use crate::render::world::World;
-
-    /// A sphere emits only from its cap (light samples land nowhere else,
-    /// so a hit elsewhere must get no light pdf), and from all of it when
-    /// whole; a triangle from all of it.
-    #[test]
-    fn an_emitter_emits_from_its_cap_only() {
-        let (center, radius) = (Vec3::new(0.5, 2.0, -1.0), 2.0);
-        let cap = EmitterCap::in_half_space(center, radius, Vec3::Y, 1.0); // y > 1: 1 − cos θ = 1.5
-        let sphere = Emitter::Sphere { sphere: 0, shape: CappedSphere { center, radius, cap } };
-        let on = |theta: f32| center + radius * Vec3::new(theta.sin(), theta.cos(), 0.0);
-        // cos θ ≥ −0.5: θ up to 120°
-        for (degrees, emits) in [(0.0, true), (60.0, true), (115.0, true), (125.0, false), (180.0, false)] {
-            assert_eq!(sphere.emits_at(on(f32::to_radians(degrees))), emits, "θ = {degrees}°");
-        }
-        let whole = Emitter::Sphere { sphere: 0, shape: CappedSphere { center, radius, cap: EmitterCap::WHOLE } };
-        assert!(whole.emits_at(on(std::f32::consts::PI)));
-        assert!((sphere.area() - 2.0 * std::f32::consts::PI * 4.0 * 1.5).abs() < 1e-4);
-        let shape = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
-        let triangle = Emitter::Triangle { triangle: 0, shape };
-        assert!(triangle.emits_at(Vec3::new(0.25, 0.25, 0.0)));
-        assert_eq!(triangle.area(), 0.5);
-    }
-
-    /// The error bound of an emitter covers how far the points drawn on it
-    /// lie from its surface, measured in f64 (and they do stray: the bound
-    /// is needed): on smallpt's light, radius 600 with its centre near 700,
-    /// whole and cut, a small sphere far from the origin, and a triangle.
-    #[test]
-    fn emitter_points_lie_within_their_error_bound() {
-        let mut sampler = Sampler::new(5, 0, 11);
-        let mut check = |emitter: Emitter, distance: &dyn Fn(Vec3) -> f64| {
-            let mut worst = 0.0f64;
-            for _ in 0..20_000 {
-                let (point, _, error) = emitter.uniform_point(sampler.next_2d());
-                let off = distance(point);
-                assert!(off <= error as f64, "{emitter:?}: {point} lies {off:e} off, bound {error:e}");
-                worst = worst.max(off);
-            }
-            assert!(worst > 0.0, "{emitter:?}: every point exact");
-        };
-        for (center, radius) in [(Vec3::new(50.0, 681.33, 81.6), 600.0), (Vec3::new(-300.0, 2.0, 1000.0), 0.125)] {
-            let cut = EmitterCap::in_half_space(center, radius, Vec3::Y, center.y - 0.5 * radius);
-            for cap in [EmitterCap::WHOLE, cut] {
-                let sphere = Emitter::Sphere { sphere: 0, shape: CappedSphere { center, radius, cap } };
-                check(sphere, &|p| ((p.as_dvec3() - center.as_dvec3()).length() - radius as f64).abs());
-            }
-        }
-        let [a, b, c] = [Vec3::new(-40.0, 3.0, 7.5), Vec3::new(-39.0, 3.5, 7.0), Vec3::new(-40.5, 4.0, 8.0)];
-        let normal = (b - a).as_dvec3().cross((c - a).as_dvec3()).normalize();
-        let triangle = Emitter::Triangle { triangle: 0, shape: Triangle::new(a, b, c) };
-        check(triangle, &|p| normal.dot(p.as_dvec3() - a.as_dvec3()).abs());
-    }
 
     /// Point and spot lights give I·att(d) (times the spot factor) toward
     /// the light, with an infinite pdf; a spot gives nothing outside its
@@ -376,7 +266,7 @@ mod tests {
     fn smallpt_light_samples_land_under_the_ceiling() {
         let scene = crate::scene::presets::preset("smallpt").and_then(Result::ok).expect("smallpt preset");
         let (world, _) = World::for_view(&scene, &CameraModel::new(&scene.camera, 64, 48), 64, 48);
-        let ceiling = world.spheres.center(5).as_dvec3();
+        let ceiling = world.shapes.spheres.center(5).as_dvec3();
         let mut s = Sampler::new(0, 0, 600);
         let (mut taken, mut reached) = (0, 0);
         for _ in 0..2000 {

@@ -18,14 +18,14 @@ use glam::Vec3;
 use crate::geometry::real::V3;
 use crate::geometry::sphere::{wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{plane_exit_t, plane_hit, plane_t, sphere_hit};
-use crate::geometry::{Ray, SurfaceHit, Triangle};
-use crate::scene::{LightKind, MaterialModel, Rgb, Shape, ValidScene};
+use crate::geometry::{Ray, SurfaceHit};
+use crate::scene::{LightKind, MaterialModel, Rgb, ValidScene};
 use camera::CameraModel;
 use light::{Emitter, LightSource};
 use occluders::{Occluders, Shadow, WallPlane, Walls};
 use shapes::sphere::Sphere;
-use shapes::{CappedSphere, EmitterCap, SphereLanes, TriangleLanes};
-pub use shapes::{ObjectInfo, PlaneShape, ShapeRef, Spheres};
+use shapes::{EmitterCap, SphereLanes};
+pub use shapes::{ObjectInfo, PlaneShape, ShapeRef, Shapes, Spheres};
 
 /// What `intersect_held` found nearest.
 /// What `World::reach` gives a ray to meet.
@@ -54,11 +54,7 @@ pub struct Hit {
 
 #[derive(Clone, Debug)]
 pub struct World {
-    pub spheres: Spheres,
-    pub planes: Vec<PlaneShape>,
-    pub triangles: Vec<(Triangle, u32)>,
-    /// The same triangles four to a SIMD group, for the hit loops.
-    pub(crate) triangle_lanes: TriangleLanes,
+    pub shapes: Shapes,
     pub objects: Vec<ObjectInfo>,
     pub materials: Vec<MaterialModel>,
     pub lights: Vec<LightSource>,
@@ -132,11 +128,9 @@ fn nearest_nine_tenths(points: &[Vec3]) -> Vec<Vec3> {
 impl World {
     /// Compile a scene for rendering.
     pub fn new(scene: &ValidScene) -> Self {
+        let (shapes, refs) = Shapes::new(scene.objects.iter().zip(0..).map(|(object, id)| (&object.shape, id)));
         let mut world = World {
-            spheres: Spheres::default(),
-            planes: Vec::new(),
-            triangles: Vec::new(),
-            triangle_lanes: TriangleLanes::default(),
+            shapes,
             objects: Vec::with_capacity(scene.objects.len()),
             materials: scene.materials.iter().map(|m| m.model.clone()).collect(),
             lights: Vec::new(),
@@ -149,36 +143,11 @@ impl World {
             walls: Walls::default(),
             light_plane: Vec::new(),
         };
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        let mut spheres = Vec::new();
-        for (index, object) in scene.objects.iter().enumerate() {
-            let id = index as u32;
+        for (object, shape) in scene.objects.iter().zip(refs) {
             let material = scene.material_index(&object.material).unwrap_or(0) as u32;
-            let shape = match &object.shape {
-                Shape::Sphere { center, radius } => {
-                    spheres.push(Sphere { center: *center, radius: *radius, object: id });
-                    lo = lo.min(*center - *radius);
-                    hi = hi.max(*center + *radius);
-                    ShapeRef::Sphere(spheres.len() as u32 - 1)
-                }
-                Shape::Plane { point, normal } => {
-                    let normal = normal.normalize();
-                    world.planes.push(PlaneShape { normal, offset: normal.dot(*point), object: id });
-                    ShapeRef::Plane(world.planes.len() as u32 - 1)
-                }
-                Shape::Triangle { a, b, c } => {
-                    lo = lo.min(a.min(b.min(*c)));
-                    hi = hi.max(a.max(b.max(*c)));
-                    world.triangles.push((Triangle::new(*a, *b, *c), id));
-                    ShapeRef::Triangle(world.triangles.len() as u32 - 1)
-                }
-            };
             world.objects.push(ObjectInfo { shape, material, light: None });
         }
-        world.spheres = Spheres::new(spheres);
-        Triangle::share_planes(&mut world.triangles.iter_mut().map(|(triangle, _)| triangle).collect::<Vec<_>>());
-        world.triangle_lanes = TriangleLanes::new(&world.triangles);
-        if lo.x <= hi.x {
+        if let Some((lo, hi)) = world.shapes.finite_box() {
             world.bounds_center = (lo + hi) * 0.5;
             world.bounds_radius = (hi - lo).length() * 0.5;
             world.region = emission::Bounds { lo, hi };
@@ -208,25 +177,8 @@ impl World {
         for index in 0..world.objects.len() {
             let info = world.objects[index];
             if let MaterialModel::Emissive { radiance } = world.materials[info.material as usize] {
-                let sampled = match info.shape {
-                    ShapeRef::Sphere(_) => true,
-                    ShapeRef::Triangle(t) => !world.triangles[t as usize].0.is_degenerate(),
-                    ShapeRef::Plane(_) => false,
-                };
-                if sampled && radiance.max_element() > 0.0 {
-                    let emitter = match info.shape {
-                        ShapeRef::Sphere(i) => {
-                            let Sphere { center, radius, .. } = world.spheres.list[i as usize];
-                            Emitter::Sphere {
-                                sphere: i,
-                                shape: CappedSphere { center, radius, cap: EmitterCap::WHOLE },
-                            }
-                        }
-                        ShapeRef::Triangle(t) => {
-                            Emitter::Triangle { triangle: t, shape: world.triangles[t as usize].0 }
-                        }
-                        ShapeRef::Plane(_) => continue,
-                    };
+                let emitter = world.shapes.emitter(info.shape).filter(|_| radiance.max_element() > 0.0);
+                if let Some(emitter) = emitter {
                     world.objects[index].light = Some(world.lights.len() as u32);
                     world.lights.push(LightSource::Area { object: index as u32, radiance, emitter });
                 }
@@ -242,9 +194,9 @@ impl World {
                 _ => None,
             })
             .collect();
-        world.light_plane = (world.triangles.iter())
+        world.light_plane = (world.shapes.triangles.iter())
             .map(|(t, _)| {
-                let holds = |&j: &u32| world.triangles[j as usize].0.holds_in_plane(t);
+                let holds = |&j: &u32| world.shapes.triangles[j as usize].0.holds_in_plane(t);
                 light_triangles.iter().copied().find(holds).unwrap_or(u32::MAX)
             })
             .collect();
@@ -271,7 +223,12 @@ impl World {
                 planes: &walls.planes,
                 wall_planes: &walls.wall_planes,
             },
-            false => Reach { spheres: &self.spheres.lanes, wall_spheres: &[], planes: &self.planes, wall_planes: &[] },
+            false => Reach {
+                spheres: &self.shapes.spheres.lanes,
+                wall_spheres: &[],
+                planes: &self.shapes.planes,
+                wall_planes: &[],
+            },
         }
     }
 
@@ -287,8 +244,8 @@ impl World {
     #[inline]
     pub fn occluders(&self, held: bool) -> Occluders<'_> {
         let s = self;
-        let triangles = (&s.triangles[..], &s.triangle_lanes);
-        Occluders::for_path(&s.walls, &s.spheres.lanes, &s.planes, triangles, &s.light_plane, held)
+        let triangles = (&s.shapes.triangles[..], &s.shapes.triangle_lanes);
+        Occluders::for_path(&s.walls, &s.shapes.spheres.lanes, &s.shapes.planes, triangles, &s.light_plane, held)
     }
 
     /// Whether anything blocks `shadow` (tested against what can block it
@@ -306,7 +263,7 @@ impl World {
     #[inline]
     pub fn intersect_held(&self, ray: &Ray, t_max: f32, held: bool) -> Option<Hit> {
         let reach = self.reach(held);
-        let s = &self.spheres;
+        let s = &self.shapes.spheres;
         let mut best_t = t_max;
         let mut best = None;
         if let Some((i, t, near)) = reach.spheres.nearest(ray, best_t) {
@@ -334,7 +291,7 @@ impl World {
                 best = Some(Inside::Plane(&wall.plane));
             }
         }
-        let triangle_hit = self.triangle_lanes.nearest(&self.triangles, ray, best_t);
+        let triangle_hit = self.shapes.triangle_lanes.nearest(&self.shapes.triangles, ray, best_t);
         if let Some((i, hit)) = triangle_hit {
             best_t = hit.t;
             best = Some(Inside::Triangle(i));
@@ -352,7 +309,7 @@ impl World {
                 (surface, s.list[*i as usize].object)
             }
             Inside::Plane(plane) => (plane_hit(ray, plane.normal, plane.offset, best_t), plane.object),
-            Inside::Triangle(i) => (triangle_hit?.1, self.triangles[i as usize].1),
+            Inside::Triangle(i) => (triangle_hit?.1, self.shapes.triangles[i as usize].1),
         };
         Some(Hit { surface, object, material: self.objects[object as usize].material })
     }
@@ -361,9 +318,9 @@ impl World {
     /// first blocker.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.spheres.lanes.any_hit(ray, t_max)
-            || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
-            || self.triangle_lanes.any_hit(&self.triangles, ray, t_max, |_| false)
+        self.shapes.spheres.lanes.any_hit(ray, t_max)
+            || self.shapes.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
+            || self.shapes.triangle_lanes.any_hit(&self.shapes.triangles, ray, t_max, |_| false)
     }
 
     /// The world as a render through `camera` at width × height uses it
@@ -422,7 +379,7 @@ impl World {
             let material = &self.materials[self.objects[object as usize].material as usize];
             !matches!(material, MaterialModel::Glass { .. } | MaterialModel::Emissive { .. })
         };
-        self.walls = Walls::find(&self.spheres, &self.planes, opaque, &self.lights, eye);
+        self.walls = Walls::find(&self.shapes.spheres, &self.shapes.planes, opaque, &self.lights, eye);
     }
 
     /// The part of sphere `sphere` that lights the scene, when it is an
@@ -455,7 +412,7 @@ impl World {
     ///   part within that region (a guess: light from the rest is left to
     ///   BSDF sampling).
     fn emitter_caps(&self, eye: Option<Vec3>) -> Vec<EmitterCap> {
-        let s = &self.spheres;
+        let s = &self.shapes.spheres;
         let count = s.len();
         let material = |i: usize| &self.materials[self.objects[s.list[i].object as usize].material as usize];
         let enclosing: Vec<usize> = match eye {
@@ -467,7 +424,7 @@ impl World {
         };
         // Opaque planes, with the normal of the camera's side
         let sides: Vec<(Vec3, f32, u32)> = match eye {
-            Some(eye) => (self.planes.iter())
+            Some(eye) => (self.shapes.planes.iter())
                 .filter(|p| {
                     let material = &self.materials[self.objects[p.object as usize].material as usize];
                     !matches!(material, MaterialModel::Glass { .. } | MaterialModel::Emissive { .. })

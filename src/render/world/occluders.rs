@@ -503,7 +503,8 @@ mod tests {
             for _ in 0..4000 {
                 let mut ray = camera.pixel_ray(64.0 * s.next_f32(), 48.0 * s.next_f32());
                 let occluders = w.occluders(w.holds(ray.origin));
-                let skips = occluders.spheres.len() + occluders.planes.len() < w.spheres.lanes.len() + w.planes.len();
+                let skips = occluders.spheres.len() + occluders.planes.len()
+                    < w.shapes.spheres.lanes.len() + w.shapes.planes.len();
                 skipping_paths += skips as u32;
                 for _ in 0..4 {
                     let Some(hit) = w.intersect(&ray, f32::INFINITY) else { break };
@@ -525,14 +526,19 @@ mod tests {
                         }
                         assert!(everything, "{name}: skipping found a blocker testing everything did not");
                         let own_plane = sample.on_triangle.is_some_and(|t| {
-                            w.triangles.iter().zip(&w.light_plane).any(|((triangle, _), plane)| {
+                            w.shapes.triangles.iter().zip(&w.light_plane).any(|((triangle, _), plane)| {
                                 *plane == w.light_plane[t as usize]
                                     && intersect_triangle(shadow, triangle, t_max).is_some()
                             })
                         });
                         let own_sphere = sample.on_sphere.is_some_and(|i| {
-                            sphere_t(shadow, w.spheres.center(i as usize), w.spheres.radius(i as usize), t_max)
-                                .is_some()
+                            sphere_t(
+                                shadow,
+                                w.shapes.spheres.center(i as usize),
+                                w.shapes.spheres.radius(i as usize),
+                                t_max,
+                            )
+                            .is_some()
                         });
                         let target = shadow.origin.as_dvec3() + shadow.direction.as_dvec3() * t_max as f64;
                         assert!(

@@ -12,7 +12,7 @@ use crate::geometry::{offset_ray_origin, Frame, Ray};
 use crate::render::world::light::{spot_factor, LightSource};
 use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::{uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_sphere_pdf};
-use crate::render::world::{ShapeRef, World};
+use crate::render::world::World;
 use crate::scene::Rgb;
 
 #[inline]
@@ -91,16 +91,7 @@ pub fn specular_targets(world: &World) -> Vec<(Vec3, f32)> {
         .iter()
         .filter(|o| crate::render::world::materials::Bsdf::new(&world.materials[o.material as usize]).is_specular())
         .filter(|o| !matches!(world.materials[o.material as usize], crate::scene::MaterialModel::Emissive { .. }))
-        .filter_map(|o| match o.shape {
-            ShapeRef::Sphere(i) => Some((world.spheres.center(i as usize), world.spheres.radius(i as usize))),
-            ShapeRef::Triangle(t) => {
-                let [a, b, c] = world.triangles[t as usize].0.vertices;
-                let center = (a + b + c) / 3.0;
-                let radius = (a - center).length().max((b - center).length()).max((c - center).length());
-                Some((center, radius * 1.001))
-            }
-            ShapeRef::Plane(_) => None,
-        })
+        .filter_map(|o| world.shapes.bounding_ball(o.shape))
         .collect()
 }
 

@@ -102,7 +102,7 @@ impl LaneWorld {
         // Planes: in index order for paths not held (`World::intersect`);
         // for held ones the planes that are not walls, then the walls'
         // ways out (`World::intersect_held`)
-        let first_plane = self.spheres.len() as f32;
+        let first_plane = self.index.first_plane as f32;
         let mut k = F8::splat(first_plane);
         for plane in &self.planes {
             if plane.wall.is_none() || !every_held {
@@ -128,7 +128,7 @@ impl LaneWorld {
         }
         // Triangles last, as both do: the crossing where the cull is sure,
         // the watertight test in the other lanes it lets through
-        let first_triangle = first_plane + self.planes.len() as f32;
+        let first_triangle = self.index.first_triangle as f32;
         let (mut triangle_point, mut triangle_normal, mut triangle_error) =
             (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
         let mut crossing = RunCrossing::new();

@@ -37,7 +37,7 @@ use crate::geometry::Triangle;
 use crate::render::world::lanes::{self, Column, Column3, Index8, F8, LANES, M8, V8};
 use crate::render::world::light::{Emitter, LightSource};
 pub(crate) use crate::render::world::materials::lanes::{LaneSurfaces, MaterialTable, Scattered};
-use crate::render::world::shapes::sphere::Sphere;
+use crate::render::world::shapes::{sphere::Sphere, ShapeIndex};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::Rgb;
 
@@ -107,7 +107,8 @@ struct Occluder {
 pub(crate) struct LaneHits {
     pub(crate) found: M8,
     pub(crate) t: F8,
-    /// Spheres, then planes, then triangles: an index into `surfaces`.
+    /// The shape hit, counted as `LaneWorld::index` counts: an index into
+    /// `surfaces`.
     pub(crate) shape: Index8,
     pub(crate) point: V8,
     /// The geometric normal.
@@ -133,7 +134,10 @@ pub struct LaneWorld {
     /// Each triangle's light plane (`World::light_plane`): a shadow ray
     /// toward a light on a triangle skips the triangles of its plane.
     triangle_planes: Vec<u32>,
-    /// Spheres, then planes, then triangles: each one's material.
+    /// Where each kind starts in the count of every shape (the index a
+    /// hit carries to its surface).
+    index: ShapeIndex,
+    /// Every shape's material, in `index`'s order.
     pub(crate) surfaces: MaterialTable,
     /// Shadow rays test these always, and the walls only for paths not
     /// inside every wall (see `occluders::Walls`).
@@ -160,12 +164,10 @@ impl LaneWorld {
         if !lanes::supported() {
             return None;
         }
-        let s = &world.spheres;
-        let objects = s.list.iter().map(|sphere| sphere.object);
-        let objects = objects.chain(world.planes.iter().map(|p| p.object));
-        let objects = objects.chain(world.triangles.iter().map(|(_, object)| *object));
-        let surfaces =
-            MaterialTable::new(objects, |object| &world.materials[world.objects[object as usize].material as usize]);
+        let s = &world.shapes.spheres;
+        let index = world.shapes.index();
+        let material = |object: u32| &world.materials[world.objects[object as usize].material as usize];
+        let surfaces = MaterialTable::new(world.shapes.objects(), material);
         if surfaces.is_empty() {
             return None;
         }
@@ -178,7 +180,7 @@ impl LaneWorld {
                 wall: wall(i),
             })
             .collect();
-        let planes: Vec<PlaneInfo> = (world.planes.iter())
+        let planes: Vec<PlaneInfo> = (world.shapes.planes.iter())
             .map(|plane| PlaneInfo {
                 normal: plane.normal,
                 offset: plane.offset,
@@ -211,10 +213,11 @@ impl LaneWorld {
             emitter: light_spheres.contains(&Some(i as u32)).then_some(i as u32),
         };
         let (walls, others) = (0..spheres.len()).partition::<Vec<_>, _>(|&i| spheres[i].wall.is_some());
-        let before_planes = std::iter::repeat_n(None, spheres.len());
+        let before_planes = std::iter::repeat_n(None, index.first_plane as usize);
         let by_shape = || before_planes.clone().chain(planes.iter().map(Some));
         let inner_spheres = spheres.iter().filter(|s| s.wall.is_none()).copied().collect();
         Some(LaneWorld {
+            index,
             inner_spheres,
             others: others.into_iter().map(occluder).collect(),
             walls: walls.into_iter().map(occluder).collect(),
@@ -223,8 +226,8 @@ impl LaneWorld {
             plane_normals: Column3::new(by_shape().map(|p| p.map_or(Vec3::ZERO, |p| p.normal))),
             plane_offsets: Column::new(by_shape().map(|p| p.map_or(0.0, |p| p.offset))),
             planes,
-            triangles: world.triangles.iter().map(|(triangle, _)| *triangle).collect(),
-            triangle_culls: lane_culls(&world.triangles),
+            triangles: world.shapes.triangles.iter().map(|(triangle, _)| *triangle).collect(),
+            triangle_culls: lane_culls(&world.shapes.triangles),
             triangle_planes: world.light_plane.clone(),
             surfaces,
             lights: LaneLights::new(world),
