@@ -12,7 +12,7 @@ use gi_studio::geometry::SurfaceHit;
 use gi_studio::render::integrators::bidir::mis::{self, MergeBehind, Partials, Strategies};
 use gi_studio::render::world::camera::CameraModel;
 use gi_studio::render::world::emission::Bounds;
-use gi_studio::render::world::light::LightSource;
+use gi_studio::render::world::light::{LightSource, PointLight};
 use gi_studio::render::world::materials::Bsdf;
 use gi_studio::render::world::rng::Sampler;
 use gi_studio::render::world::World;
@@ -278,8 +278,11 @@ fn the_weights_of_every_strategy_sum_to_one() {
             vec![],
         )));
         let area = world.lights[0].clone();
-        let point =
-            LightSource::Point { position: path.points[0], intensity: Vec3::ONE, attenuation: Attenuation::default() };
+        let point = LightSource::Point(PointLight {
+            position: path.points[0],
+            intensity: Vec3::ONE,
+            attenuation: Attenuation::default(),
+        });
         for light in [&area, &point] {
             for heuristic in [MisHeuristic::Power, MisHeuristic::Balance] {
                 let ways = [(true, false, false), (false, true, false), (true, true, false), (true, true, true)];

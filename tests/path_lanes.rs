@@ -286,7 +286,7 @@ fn the_seam_of_the_light_and_the_ceiling_bit_for_bit() {
 #[test]
 fn shadow_rays_in_lanes_are_blocked_as_one_at_a_time() {
     use gi_studio::geometry::Ray;
-    use gi_studio::render::world::light::{Emitter, LightSource};
+    use gi_studio::render::world::light::{AreaLight, Emitter, LightSource};
     use gi_studio::render::world::occluders::Shadow;
     use gi_studio::render::world::rng::Sampler;
     use gi_studio::render::world::sampling::uniform_sphere;
@@ -311,7 +311,7 @@ fn shadow_rays_in_lanes_are_blocked_as_one_at_a_time() {
         // Straight through each light triangle to beyond it: only what it
         // ends on (its plane's triangles) is skipped
         for light in &world.lights {
-            if let LightSource::Area { emitter: Emitter::Triangle { triangle, shape }, .. } = light {
+            if let LightSource::Area(AreaLight { emitter: Emitter::Triangle { triangle, shape }, .. }) = light {
                 let [a, b, c] = shape.vertices;
                 for k in 0..40 {
                     let target = (a + b + c) / 3.0 + (b - a) * (k as f32 / 100.0);

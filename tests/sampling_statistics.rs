@@ -12,7 +12,7 @@ use std::f32::consts::PI;
 use common::stats::*;
 use common::*;
 use gi_studio::geometry::{intersect_sphere, intersect_triangle, Ray, SurfaceHit};
-use gi_studio::render::world::light::LightSource;
+use gi_studio::render::world::light::{AreaLight, LightSource};
 use gi_studio::render::world::rng::Sampler;
 use gi_studio::render::world::sampling::*;
 use gi_studio::render::world::World;
@@ -127,7 +127,7 @@ fn cell_index(i: usize, j: usize, size: usize) -> usize {
 /// What `light` says of the direction `d` from `at`: its pdf where the ray
 /// meets its emitter first, 0 where it misses.
 fn light_pdf_toward(light: &LightSource, world: &World, at: Vec3, d: Vec3) -> f64 {
-    let LightSource::Area { object, .. } = light else { return 0.0 };
+    let LightSource::Area(AreaLight { object, .. }) = light else { return 0.0 };
     let ray = Ray::new(at, d);
     let hit = match world.objects[*object as usize].shape {
         gi_studio::render::world::ShapeRef::Sphere(i) => intersect_sphere(

@@ -1,19 +1,12 @@
-//! Light leaving the lights: where a photon or a light path starts, what it
-//! carries, and the densities its sampling had. Multiple importance
-//! sampling between paths from the camera and paths from the lights needs
-//! those densities for any point on a light, not only sampled ones
-//! (`emission_pdf`, `direct_pdf_a`). Infinite lights (directional, the
-//! background) emit from a rectangle covering the shadow of the region the
-//! camera sees (`Bounds`).
-
-use std::f32::consts::PI;
+//! Light leaving the lights: what a start of a photon or a light path
+//! carries (`Emission`; each kind of light's `emit` is in its file of
+//! `light/`), and where infinite lights (directional, the background) start
+//! it: on a rectangle covering the shadow of the region the camera sees
+//! (`Bounds`).
 
 use glam::{Vec2, Vec3};
 
-use super::light::{spot_factor, LightSource};
-use super::sampling::uniform_sphere_pdf;
-use super::sampling::{cosine_hemisphere, uniform_cone, uniform_cone_pdf, uniform_sphere};
-use crate::geometry::{offset_ray_origin, pow, Frame, Ray, SurfaceHit};
+use crate::geometry::{Frame, Ray};
 use crate::scene::Rgb;
 
 /// The box infinite lights must light (`World::bounds`). Light from a
@@ -63,7 +56,7 @@ impl Bounds {
 
     /// Where light travelling along `direction` starts: `u` on the cover,
     /// a box's diagonal behind it; and the cover's area.
-    fn start(&self, direction: Vec3, u: Vec2) -> (Ray, f32) {
+    pub(crate) fn start(&self, direction: Vec3, u: Vec2) -> (Ray, f32) {
         let cover = self.cover(direction);
         let Cover { frame, x, y, back } = cover;
         let (a, b) = (x.0 + (x.1 - x.0) * u.x, y.0 + (y.1 - y.0) * u.y);
@@ -74,7 +67,7 @@ impl Bounds {
     /// The cover's density of starts, where the line through `point` along
     /// `direction` crosses it (0 outside: no light path from it reaches
     /// `point` that way).
-    fn start_pdf(&self, point: Vec3, direction: Vec3) -> f32 {
+    pub(crate) fn start_pdf(&self, point: Vec3, direction: Vec3) -> f32 {
         let cover = self.cover(direction);
         let (u, v) = (point.dot(cover.frame.x), point.dot(cover.frame.y));
         let inside = (cover.x.0..=cover.x.1).contains(&u) && (cover.y.0..=cover.y.1).contains(&v);
@@ -87,12 +80,12 @@ impl Bounds {
     }
 
     /// The cover's area across `direction`.
-    fn area(&self, direction: Vec3) -> f32 {
+    pub(crate) fn area(&self, direction: Vec3) -> f32 {
         self.cover(direction).area().max(0.0)
     }
 
     /// The box's mean shadow over all directions: a quarter of its surface.
-    fn mean_shadow(&self) -> f32 {
+    pub(crate) fn mean_shadow(&self) -> f32 {
         let d = (self.hi - self.lo).max(Vec3::ZERO);
         (d.x * d.y + d.y * d.z + d.z * d.x) * 0.5
     }
@@ -125,133 +118,11 @@ pub struct Emission {
     pub normal: Vec3,
 }
 
-impl LightSource {
-    /// Total emitted power (for the background, over the mean cover, taken
-    /// as the box's mean shadow: a quarter of its surface, by Cauchy).
-    pub fn power(&self, bounds: Bounds) -> Rgb {
-        match *self {
-            LightSource::Point { intensity, .. } => intensity * (4.0 * PI),
-            LightSource::Spot { intensity, cos_cone, exponent, .. } => {
-                // ∫ over the cone of cos^σ θ dω = 2π (1 − cos^{σ+1} θc)/(σ + 1)
-                intensity * (2.0 * PI * (1.0 - pow::powf(cos_cone, exponent + 1.0)) / (exponent + 1.0))
-            }
-            LightSource::Directional { irradiance, direction } => irradiance * bounds.area(direction),
-            LightSource::Area { radiance, ref emitter, .. } => radiance * (PI * emitter.area()),
-            LightSource::Background { radiance } => radiance * (4.0 * PI * bounds.mean_shadow()),
-        }
-    }
-
-    /// Whether it is at a finite distance (not directional, not the background).
-    pub fn is_finite(&self) -> bool {
-        !matches!(self, LightSource::Directional { .. } | LightSource::Background { .. })
-    }
-
-    /// Sample a start of light from two uniform pairs: `u1` for a point or
-    /// spot light's direction, an area light's point, a directional light's
-    /// cover and the background's direction; `u2` for an area light's
-    /// direction and the background's cover.
-    pub fn emit(&self, bounds: Bounds, u1: Vec2, u2: Vec2) -> Emission {
-        match *self {
-            LightSource::Point { position, intensity, .. } => Emission {
-                ray: Ray::new(position, uniform_sphere(u1)),
-                power: intensity * (4.0 * PI),
-                pdf: uniform_sphere_pdf(),
-                cos: 1.0,
-                point: position,
-                normal: Vec3::ZERO,
-            },
-            LightSource::Spot { position, direction, cos_cone, exponent, intensity, .. } => {
-                let one_minus_cos = 1.0 - cos_cone;
-                let d = Frame::from_z(direction).to_world(uniform_cone(u1, one_minus_cos));
-                let falloff = spot_factor(direction, d, cos_cone, exponent);
-                let pdf = uniform_cone_pdf(one_minus_cos);
-                let power = intensity * (falloff / pdf);
-                Emission { ray: Ray::new(position, d), power, pdf, cos: 1.0, point: position, normal: Vec3::ZERO }
-            }
-            LightSource::Directional { direction, irradiance } => {
-                let (ray, area) = bounds.start(direction, u1);
-                let (power, pdf) = (irradiance * area, if area > 0.0 { 1.0 / area } else { 0.0 });
-                Emission { ray, power, pdf, cos: 1.0, point: ray.origin, normal: Vec3::ZERO }
-            }
-            LightSource::Background { radiance } => {
-                // Light from every direction: it travels along −ω for a sky direction ω
-                let direction = -uniform_sphere(u1);
-                let (ray, area) = bounds.start(direction, u2);
-                Emission {
-                    ray,
-                    power: radiance * (4.0 * PI * area),
-                    pdf: if area > 0.0 { uniform_sphere_pdf() / area } else { 0.0 },
-                    cos: 1.0,
-                    point: ray.origin,
-                    normal: Vec3::ZERO,
-                }
-            }
-            LightSource::Area { radiance, ref emitter, .. } => {
-                let (point, normal, error) = emitter.uniform_point(u1);
-                let local = cosine_hemisphere(u2);
-                let d = Frame::from_z(normal).to_world(local);
-                // Cosine-weighted: L cos θ / (pdf_area · cos θ/π) = π L A
-                let origin = offset_ray_origin(point, error, normal, d);
-                let area = emitter.area();
-                Emission {
-                    ray: Ray::new(origin, d),
-                    power: radiance * (PI * area),
-                    pdf: local.z / (PI * area),
-                    cos: local.z,
-                    point,
-                    normal,
-                }
-            }
-        }
-    }
-
-    /// The density `emit` has of starting at `point` (on the light, with its
-    /// `normal`; ignored for infinite lights) and leaving along `direction`.
-    pub fn emission_pdf(&self, bounds: Bounds, point: Vec3, normal: Vec3, direction: Vec3) -> f32 {
-        match *self {
-            LightSource::Point { .. } => uniform_sphere_pdf(),
-            LightSource::Spot { direction: axis, cos_cone, .. } => {
-                if axis.dot(direction) >= cos_cone {
-                    uniform_cone_pdf(1.0 - cos_cone)
-                } else {
-                    0.0
-                }
-            }
-            LightSource::Directional { .. } => bounds.start_pdf(point, direction),
-            LightSource::Background { .. } => uniform_sphere_pdf() * bounds.start_pdf(point, direction),
-            LightSource::Area { ref emitter, .. } => {
-                let cos = normal.dot(direction);
-                if cos <= 0.0 || !emitter.emits_at(point) {
-                    return 0.0;
-                }
-                cos / (PI * emitter.area())
-            }
-        }
-    }
-
-    /// The density with which `sample` chooses the point `on_light` (with
-    /// its `normal`) from `receiver`: per area for lights at a finite
-    /// distance (1 for point and spot lights, whose position is certain),
-    /// per solid angle for infinite ones (1 for a directional light).
-    pub fn direct_pdf_a(&self, receiver: Vec3, on_light: Vec3, normal: Vec3) -> f32 {
-        match *self {
-            LightSource::Point { .. } | LightSource::Spot { .. } | LightSource::Directional { .. } => 1.0,
-            LightSource::Background { .. } => uniform_sphere_pdf(),
-            LightSource::Area { .. } => {
-                let to_light = on_light - receiver;
-                let distance2 = to_light.length_squared();
-                let cos = normal.dot(-to_light) / distance2.sqrt();
-                let hit = SurfaceHit { t: distance2.sqrt(), point: on_light, normal, error: 0.0 };
-                self.pdf(receiver, &hit) * cos.max(0.0) / distance2
-            }
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::render::world::rng::Sampler;
+    use crate::render::world::sampling::uniform_sphere;
 
     /// Light from any direction into a box starts behind it, on a cover
     /// whose density is the same wherever it starts and nothing where no

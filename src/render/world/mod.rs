@@ -157,19 +157,22 @@ impl World {
             let power = light.color * light.intensity;
             world.lights.push(match light.kind {
                 LightKind::Point { position } => {
-                    LightSource::Point { position, intensity: power, attenuation: light.attenuation }
+                    LightSource::Point(light::PointLight { position, intensity: power, attenuation: light.attenuation })
                 }
-                LightKind::Directional { direction } => {
-                    LightSource::Directional { direction: direction.normalize(), irradiance: power }
-                }
-                LightKind::Spot { position, direction, cone_angle_degrees, falloff_exponent } => LightSource::Spot {
-                    position,
+                LightKind::Directional { direction } => LightSource::Directional(light::DirectionalLight {
                     direction: direction.normalize(),
-                    cos_cone: cone_angle_degrees.to_radians().cos(),
-                    exponent: falloff_exponent,
-                    intensity: power,
-                    attenuation: light.attenuation,
-                },
+                    irradiance: power,
+                }),
+                LightKind::Spot { position, direction, cone_angle_degrees, falloff_exponent } => {
+                    LightSource::Spot(light::SpotLight {
+                        position,
+                        direction: direction.normalize(),
+                        cos_cone: cone_angle_degrees.to_radians().cos(),
+                        exponent: falloff_exponent,
+                        intensity: power,
+                        attenuation: light.attenuation,
+                    })
+                }
             });
         }
         // Emissive spheres and triangles become sampled area lights; an
@@ -180,17 +183,19 @@ impl World {
                 let emitter = world.shapes.emitter(info.shape).filter(|_| radiance.max_element() > 0.0);
                 if let Some(emitter) = emitter {
                     world.objects[index].light = Some(world.lights.len() as u32);
-                    world.lights.push(LightSource::Area { object: index as u32, radiance, emitter });
+                    world.lights.push(LightSource::Area(light::AreaLight { object: index as u32, radiance, emitter }));
                 }
             }
         }
         // The background lights the scene from every direction
         if scene.background.max_element() > 0.0 {
-            world.lights.push(LightSource::Background { radiance: scene.background });
+            world.lights.push(LightSource::Background(light::BackgroundLight { radiance: scene.background }));
         }
         let light_triangles: Vec<u32> = (world.lights.iter())
             .filter_map(|light| match light {
-                LightSource::Area { emitter: Emitter::Triangle { triangle, .. }, .. } => Some(*triangle),
+                LightSource::Area(light::AreaLight { emitter: Emitter::Triangle { triangle, .. }, .. }) => {
+                    Some(*triangle)
+                }
                 _ => None,
             })
             .collect();
@@ -385,7 +390,7 @@ impl World {
     /// The part of sphere `sphere` that lights the scene, when it is an
     /// emitter (the whole sphere otherwise).
     pub fn emitting_cap(&self, sphere: usize) -> EmitterCap {
-        let on_it = |light: &&LightSource| matches!(light, LightSource::Area { emitter: Emitter::Sphere { sphere: s, .. }, .. } if *s as usize == sphere);
+        let on_it = |light: &&LightSource| matches!(light, LightSource::Area(light::AreaLight { emitter: Emitter::Sphere { sphere: s, .. }, .. }) if *s as usize == sphere);
         self.lights.iter().find(on_it).and_then(LightSource::cap).unwrap_or(EmitterCap::WHOLE)
     }
 
@@ -393,7 +398,7 @@ impl World {
     fn fit_caps(&mut self, eye: Option<Vec3>) {
         let caps = self.emitter_caps(eye);
         for light in &mut self.lights {
-            if let LightSource::Area { emitter: Emitter::Sphere { sphere, shape }, .. } = light {
+            if let LightSource::Area(light::AreaLight { emitter: Emitter::Sphere { sphere, shape }, .. }) = light {
                 shape.cap = caps[*sphere as usize];
             }
         }

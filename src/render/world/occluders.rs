@@ -12,7 +12,7 @@
 use glam::{DVec3, Vec3};
 
 use super::lanes::{F8, M8, V8};
-use super::light::{Emitter, LightSample, LightSource};
+use super::light::{LightSample, LightSource};
 use super::shapes::{PlaneShape, SphereLanes, Spheres, TriangleLanes};
 use crate::geometry::sphere::AnchoredSphere;
 use crate::geometry::{gamma, plane_t};
@@ -130,7 +130,7 @@ impl Walls {
         let is_wall = |region: &Region, object: u32| {
             opaque(object)
                 && region.holds_strictly(eye)
-                && lights.iter().all(|light| holds_samples(light, region, object))
+                && lights.iter().all(|light| light.held_by(&|center, reach| region.holds(center, reach), object))
         };
         let s = spheres;
         let (mut regions, mut others, mut wall_spheres) = (Vec::new(), Vec::new(), Vec::new());
@@ -215,22 +215,6 @@ impl Walls {
             held.set(lane, self.hold(origins.lane(lane)));
         }
         held
-    }
-}
-
-/// Whether every sample `light` can give lies in `region`, the inside of
-/// the wall `object`.
-fn holds_samples(light: &LightSource, region: &Region, object: u32) -> bool {
-    match *light {
-        LightSource::Point { position, .. } | LightSource::Spot { position, .. } => {
-            region.holds(position.as_dvec3(), 0.0)
-        }
-        LightSource::Directional { .. } | LightSource::Background { .. } => false,
-        LightSource::Area { ref emitter, .. } => match *emitter {
-            // Cut to this wall's inside: in it by construction
-            Emitter::Sphere { shape, .. } if shape.cap.wall == Some(object) => true,
-            _ => emitter.held_by(&|center, reach| region.holds(center, reach)),
-        },
     }
 }
 

@@ -27,7 +27,6 @@ use crate::render::integrators::shadow_batch::ShadowBatch;
 use crate::render::integrators::{reorder, Counters};
 use crate::render::world::camera::CameraTile;
 use crate::render::world::lane_world::{Given, PickedLight, Want};
-use crate::render::world::light::LightSource;
 use crate::render::world::materials::{Bsdf, Transport};
 use crate::render::world::occluders::Shadow;
 use crate::render::world::rng::Sampler;
@@ -435,12 +434,7 @@ fn direct(
     }
     counters.rays += 1;
     let point = vertex.hit.surface.point;
-    let (direct_pdf, cos_at_light) = match light {
-        LightSource::Point { .. } | LightSource::Spot { .. } => ((sample.point - point).length_squared(), 1.0),
-        LightSource::Directional { .. } => (1.0, 1.0),
-        LightSource::Background { .. } => (sample.pdf, 1.0),
-        LightSource::Area { .. } => (sample.pdf, sample.normal.dot(-sample.wi)),
-    };
+    let (direct_pdf, cos_at_light) = light.direct_density(&sample, point);
     // Infinite lights emit toward the lit point from their disc
     let from = if light.is_finite() { sample.point } else { point };
     let emission_pdf = light.emission_pdf(ctx.bounds_of(light), from, sample.normal, -sample.wi);
@@ -554,6 +548,7 @@ mod tests {
     use crate::render::settings::MisHeuristic;
     use crate::render::world::camera::{CameraModel, TileRect};
     use crate::render::world::lane_world::LaneWorld;
+    use crate::render::world::light::LightSource;
     use crate::render::world::rng::PassStreams;
     use crate::render::world::World;
     use crate::scene::presets;

@@ -6,12 +6,12 @@
 
 use std::f32::consts::PI;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use crate::geometry::{offset_ray_origin, Frame, Ray};
-use crate::render::world::light::{spot_factor, LightSource};
+use crate::geometry::{Frame, Ray};
+use crate::render::world::light::Aim;
 use crate::render::world::rng::Sampler;
-use crate::render::world::sampling::{uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_sphere_pdf};
+use crate::render::world::sampling::{concentric_disk, uniform_cone, uniform_cone_pdf};
 use crate::render::world::World;
 use crate::scene::Rgb;
 
@@ -112,11 +112,43 @@ pub fn emit_toward(
     let light = &world.lights[index];
     let target = targets[((sampler.next_f32() * targets.len() as f32) as usize).min(targets.len() - 1)];
     let (u1, u2) = (sampler.next_2d(), sampler.next_2d());
-    let target_pick = 1.0 / targets.len() as f32;
-    // Solid-angle pdf of choosing direction d from `origin`, over all targets
-    let direction_pdf = |origin: Vec3, d: Vec3| -> f32 {
-        targets
-            .iter()
+    let aim =
+        Targets { targets, target, target_pick: 1.0 / targets.len() as f32, u1, u2, scene_radius: world.bounds_radius };
+    let (ray, power) = light.emit_toward(&aim, u1, u2)?;
+    power.is_finite().then_some(EmittedPhoton { ray, power: power / pick })
+}
+
+/// Caustic photons' aim: a target drawn among `targets` (bounding
+/// spheres), and the density of a direction or a start over all of them.
+struct Targets<'t> {
+    targets: &'t [(Vec3, f32)],
+    /// The target drawn, with probability `target_pick`.
+    target: (Vec3, f32),
+    target_pick: f32,
+    /// `u1` places a start on a target's disc, `u2` a direction in its cone.
+    u1: Vec2,
+    u2: Vec2,
+    /// How far upstream light from infinitely far starts.
+    scene_radius: f32,
+}
+
+impl Aim for Targets<'_> {
+    /// Within the cone the drawn target subtends from `origin`.
+    fn direction_from(&self, origin: Vec3) -> Option<Vec3> {
+        let to = self.target.0 - origin;
+        let distance2 = to.length_squared();
+        let sin2 = self.target.1 * self.target.1 / distance2;
+        if sin2 >= 1.0 {
+            return None;
+        }
+        let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
+        Some(Frame::from_z(to / distance2.sqrt()).to_world(uniform_cone(self.u2, one_minus_cos)))
+    }
+
+    /// Over every target whose cone holds `direction`, so overlapping
+    /// targets are not counted twice.
+    fn direction_pdf(&self, origin: Vec3, direction: Vec3) -> f32 {
+        (self.targets.iter())
             .filter_map(|(center, radius)| {
                 let to = *center - origin;
                 let distance2 = to.length_squared();
@@ -125,75 +157,29 @@ pub fn emit_toward(
                     return None;
                 }
                 let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
-                let cos = to.dot(d) / distance2.sqrt();
-                (cos >= 1.0 - one_minus_cos).then(|| uniform_cone_pdf(one_minus_cos) * target_pick)
+                let cos = to.dot(direction) / distance2.sqrt();
+                (cos >= 1.0 - one_minus_cos).then(|| uniform_cone_pdf(one_minus_cos) * self.target_pick)
             })
             .sum()
-    };
-    let cone_direction = |origin: Vec3| -> Option<Vec3> {
-        let to = target.0 - origin;
-        let distance2 = to.length_squared();
-        let sin2 = target.1 * target.1 / distance2;
-        if sin2 >= 1.0 {
-            return None;
-        }
-        let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
-        Some(Frame::from_z(to / distance2.sqrt()).to_world(uniform_cone(u2, one_minus_cos)))
-    };
-    // Along `direction`, from a disc just covering the target across it,
-    // upstream of the scene: the origin, and the density of origins over
-    // every target's disc that holds this line
-    let from_upstream = |direction: Vec3| -> (Vec3, f32) {
+    }
+
+    /// On a disc just covering the drawn target across `direction`,
+    /// upstream of the scene; the density of starts over every target's
+    /// disc that holds the line.
+    fn upstream(&self, direction: Vec3) -> (Vec3, f32) {
+        let (center, radius) = self.target;
         let frame = Frame::from_z(direction);
-        let disc = crate::render::world::sampling::concentric_disk(u1) * target.1;
-        let origin =
-            target.0 - direction * (2.0 * world.bounds_radius.max(target.1)) + frame.x * disc.x + frame.y * disc.y;
-        let density = targets
-            .iter()
+        let disc = concentric_disk(self.u1) * radius;
+        let origin = center - direction * (2.0 * self.scene_radius.max(radius)) + frame.x * disc.x + frame.y * disc.y;
+        let density = (self.targets.iter())
             .filter(|(c, r)| {
                 let offset = *c - origin;
                 (offset - direction * offset.dot(direction)).length_squared() <= r * r
             })
-            .map(|(_, r)| target_pick / (PI * r * r))
+            .map(|(_, r)| self.target_pick / (PI * r * r))
             .sum();
         (origin, density)
-    };
-    let (ray, power) = match *light {
-        LightSource::Point { position, intensity, .. } => {
-            let d = cone_direction(position)?;
-            (Ray::new(position, d), intensity / direction_pdf(position, d))
-        }
-        LightSource::Spot { position, direction, cos_cone, exponent, intensity, .. } => {
-            let d = cone_direction(position)?;
-            let falloff = spot_factor(direction, d, cos_cone, exponent);
-            if falloff == 0.0 {
-                return None;
-            }
-            (Ray::new(position, d), intensity * (falloff / direction_pdf(position, d)))
-        }
-        LightSource::Directional { direction, irradiance } => {
-            let (origin, density) = from_upstream(direction);
-            (Ray::new(origin, direction), irradiance / density)
-        }
-        LightSource::Background { radiance } => {
-            // A random sky direction
-            let direction = -uniform_sphere(u2);
-            let (origin, density) = from_upstream(direction);
-            (Ray::new(origin, direction), radiance / (uniform_sphere_pdf() * density))
-        }
-        LightSource::Area { radiance, ref emitter, .. } => {
-            let (point, normal, error) = emitter.uniform_point(u1);
-            let d = cone_direction(point)?;
-            let cos = normal.dot(d);
-            if cos <= 0.0 {
-                return None;
-            }
-            let origin = offset_ray_origin(point, error, normal, d);
-            let area = emitter.area();
-            (Ray::new(origin, d), radiance * (cos * area / direction_pdf(point, d)))
-        }
-    };
-    power.is_finite().then_some(EmittedPhoton { ray, power: power / pick })
+    }
 }
 
 #[cfg(test)]

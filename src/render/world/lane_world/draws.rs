@@ -13,7 +13,7 @@ use super::{LaneHits, LaneSurfaces, LaneWorld, Scattered};
 use crate::geometry::{Ray, SurfaceHit};
 use crate::render::world::camera::{CameraConnection, CameraModel, ConnectionOf};
 use crate::render::world::lanes::{self, Rng8, F8, LANES, M8, V8};
-use crate::render::world::light::{Emitter, LightSample, LightSource};
+use crate::render::world::light::{self, Emitter, LightSample, LightSource};
 use crate::render::world::materials::{BsdfSample, Transport};
 use crate::render::world::rng::Sampler;
 use crate::render::world::World;
@@ -234,8 +234,10 @@ impl Columns {
             return None;
         }
         let (on_triangle, on_sphere) = match *light {
-            LightSource::Area { emitter: Emitter::Triangle { triangle, .. }, .. } => (Some(triangle), None),
-            LightSource::Area { emitter: Emitter::Sphere { sphere, .. }, .. } => (None, Some(sphere)),
+            LightSource::Area(light::AreaLight { emitter: Emitter::Triangle { triangle, .. }, .. }) => {
+                (Some(triangle), None)
+            }
+            LightSource::Area(light::AreaLight { emitter: Emitter::Sphere { sphere, .. }, .. }) => (None, Some(sphere)),
             _ => (None, None),
         };
         let wi = lane_of(&self.wi, i);

@@ -8,7 +8,7 @@ use glam::{Vec2, Vec3};
 
 use crate::geometry::{frame_from_z, offset_origin, ray_to, to_world, SurfaceHit};
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
-use crate::render::world::light::{Emitter, LightSource};
+use crate::render::world::light::{self, Emitter, LightSource};
 use crate::render::world::sampling::{cosine_hemisphere_of, uniform_cone_of, uniform_cone_pdf_of};
 use crate::render::world::sampling::{uniform_sphere_of, uniform_triangle_of};
 use crate::render::world::shapes::sphere::{sphere_cone_normal_of, CappedSphere};
@@ -87,14 +87,14 @@ impl LaneLight {
             Some(LaneLight::Point(PointLight { position, intensity, attenuation, axis, cos_cone, exponent }))
         };
         let (radiance, emitter) = match *light {
-            LightSource::Area { radiance, emitter, .. } => (radiance, emitter),
-            LightSource::Point { position, intensity, attenuation } => {
+            LightSource::Area(light::AreaLight { radiance, emitter, .. }) => (radiance, emitter),
+            LightSource::Point(light::PointLight { position, intensity, attenuation }) => {
                 return point(position, intensity, attenuation, Vec3::Z, f32::NEG_INFINITY, 0.0);
             }
-            LightSource::Spot { position, direction, cos_cone, exponent, intensity, attenuation } => {
+            LightSource::Spot(light::SpotLight { position, direction, cos_cone, exponent, intensity, attenuation }) => {
                 return point(position, intensity, attenuation, direction, cos_cone, exponent);
             }
-            LightSource::Directional { direction, irradiance } => {
+            LightSource::Directional(light::DirectionalLight { direction, irradiance }) => {
                 return Some(LaneLight::Directional(DirectionalLight { direction, irradiance }));
             }
             LightSource::Background { .. } => return None,

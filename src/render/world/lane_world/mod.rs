@@ -35,7 +35,7 @@ use wall_exits::WallExits;
 use crate::geometry::sphere::{wall_slack, AnchoredSphere};
 use crate::geometry::Triangle;
 use crate::render::world::lanes::{self, Column, Column3, Index8, F8, LANES, M8, V8};
-use crate::render::world::light::{Emitter, LightSource};
+use crate::render::world::light::{self, Emitter, LightSource};
 pub(crate) use crate::render::world::materials::lanes::{LaneSurfaces, MaterialTable, Scattered};
 use crate::render::world::shapes::{sphere::Sphere, ShapeIndex};
 use crate::render::world::{ShapeRef, World};
@@ -191,7 +191,7 @@ impl LaneWorld {
             .collect();
         let light_planes = (world.lights.iter())
             .map(|light| match *light {
-                LightSource::Area { emitter: Emitter::Triangle { triangle, .. }, .. } => {
+                LightSource::Area(light::AreaLight { emitter: Emitter::Triangle { triangle, .. }, .. }) => {
                     Some(world.light_plane[triangle as usize])
                 }
                 _ => None,
@@ -200,7 +200,7 @@ impl LaneWorld {
         // The sphere each light lies on
         let light_spheres: Vec<Option<u32>> = (world.lights.iter())
             .map(|light| match *light {
-                LightSource::Area { object, .. } => match world.objects[object as usize].shape {
+                LightSource::Area(light::AreaLight { object, .. }) => match world.objects[object as usize].shape {
                     ShapeRef::Sphere(i) => Some(i),
                     _ => None,
                 },
