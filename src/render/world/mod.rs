@@ -19,7 +19,7 @@ use crate::geometry::real::V3;
 use crate::geometry::sphere::{wall_exit, wall_exit_hit, wall_slack, AnchoredSphere};
 use crate::geometry::{plane_exit_t, plane_hit, plane_t, sphere_hit};
 use crate::geometry::{Ray, SurfaceHit};
-use crate::scene::{LightKind, MaterialModel, Rgb, ValidScene};
+use crate::scene::{MaterialModel, Rgb, ValidScene};
 use camera::CameraModel;
 use light::{Emitter, LightSource};
 use occluders::{Occluders, Shadow, WallPlane, Walls};
@@ -153,28 +153,7 @@ impl World {
             world.region = emission::Bounds { lo, hi };
         }
         // Disabled lights are simply absent from the render
-        for light in scene.lights.iter().filter(|l| l.enabled) {
-            let power = light.color * light.intensity;
-            world.lights.push(match light.kind {
-                LightKind::Point { position } => {
-                    LightSource::Point(light::PointLight { position, intensity: power, attenuation: light.attenuation })
-                }
-                LightKind::Directional { direction } => LightSource::Directional(light::DirectionalLight {
-                    direction: direction.normalize(),
-                    irradiance: power,
-                }),
-                LightKind::Spot { position, direction, cone_angle_degrees, falloff_exponent } => {
-                    LightSource::Spot(light::SpotLight {
-                        position,
-                        direction: direction.normalize(),
-                        cos_cone: cone_angle_degrees.to_radians().cos(),
-                        exponent: falloff_exponent,
-                        intensity: power,
-                        attenuation: light.attenuation,
-                    })
-                }
-            });
-        }
+        world.lights.extend(scene.lights.iter().filter(|l| l.enabled).map(LightSource::of));
         // Emissive spheres and triangles become sampled area lights; an
         // emissive infinite plane cannot be sampled and is only found by rays.
         for index in 0..world.objects.len() {

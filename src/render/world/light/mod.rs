@@ -18,7 +18,7 @@ use super::emission::{Bounds, Emission};
 pub use super::shapes::Emitter;
 use super::shapes::EmitterCap;
 use crate::geometry::{Ray, SurfaceHit};
-use crate::scene::Rgb;
+use crate::scene::{self, LightKind, Rgb};
 pub use area::AreaLight;
 pub use background::BackgroundLight;
 pub use directional::DirectionalLight;
@@ -132,6 +132,30 @@ fn finite_of<L: Light>(_: &L) -> bool {
 }
 
 impl LightSource {
+    /// A light of the scene, as the renderer samples it (area lights and
+    /// the background come from objects and the scene's sky instead).
+    pub fn of(light: &scene::Light) -> Self {
+        let power = light.color * light.intensity;
+        match light.kind {
+            LightKind::Point { position } => {
+                LightSource::Point(PointLight { position, intensity: power, attenuation: light.attenuation })
+            }
+            LightKind::Directional { direction } => {
+                LightSource::Directional(DirectionalLight { direction: direction.normalize(), irradiance: power })
+            }
+            LightKind::Spot { position, direction, cone_angle_degrees, falloff_exponent } => {
+                LightSource::Spot(SpotLight {
+                    position,
+                    direction: direction.normalize(),
+                    cos_cone: cone_angle_degrees.to_radians().cos(),
+                    exponent: falloff_exponent,
+                    intensity: power,
+                    attenuation: light.attenuation,
+                })
+            }
+        }
+    }
+
     pub fn is_delta(&self) -> bool {
         on_light!(self, light => delta_of(light))
     }

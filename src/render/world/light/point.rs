@@ -18,16 +18,29 @@ pub struct PointLight {
     pub attenuation: Attenuation,
 }
 
+impl PointLight {
+    /// Its light arriving at `at`, times `factor` of the way it leaves the
+    /// light (a spot's cone); `None` where that is 0.
+    #[inline]
+    pub(super) fn sample_within(&self, at: &SurfaceHit, factor: impl Fn(Vec3) -> f32) -> Option<LightSample> {
+        let (shadow, shadow_t_max) = at.spawn_ray_to(self.position, 0.0);
+        let d = (self.position - at.point).length();
+        let factor = factor(-shadow.direction);
+        if factor == 0.0 {
+            return None;
+        }
+        let value = self.intensity * (self.attenuation.factor(d) * factor);
+        Some(LightSample::delta(shadow, shadow_t_max, value, self.position))
+    }
+}
+
 impl Light for PointLight {
     const DELTA: bool = true;
     const FINITE: bool = true;
 
     #[inline]
     fn sample(&self, at: &SurfaceHit, _u: Vec2) -> Option<LightSample> {
-        let (shadow, shadow_t_max) = at.spawn_ray_to(self.position, 0.0);
-        let d = (self.position - at.point).length();
-        let value = self.intensity * self.attenuation.factor(d);
-        Some(LightSample::delta(shadow, shadow_t_max, value, self.position))
+        self.sample_within(at, |_| 1.0)
     }
 
     fn power(&self, _bounds: Bounds) -> Rgb {

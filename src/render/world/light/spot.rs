@@ -5,7 +5,7 @@ use std::f32::consts::PI;
 
 use glam::{DVec3, Vec2, Vec3};
 
-use super::{Aim, Light, LightSample};
+use super::{Aim, Light, LightSample, PointLight};
 use crate::geometry::{pow, Frame, Ray, SurfaceHit};
 use crate::render::world::emission::{Bounds, Emission};
 use crate::render::world::sampling::{uniform_cone, uniform_cone_pdf};
@@ -47,14 +47,8 @@ impl Light for SpotLight {
 
     #[inline]
     fn sample(&self, at: &SurfaceHit, _u: Vec2) -> Option<LightSample> {
-        let (shadow, shadow_t_max) = at.spawn_ray_to(self.position, 0.0);
-        let d = (self.position - at.point).length();
-        let factor = self.factor(-shadow.direction);
-        if factor == 0.0 {
-            return None;
-        }
-        let value = self.intensity * (self.attenuation.factor(d) * factor);
-        Some(LightSample::delta(shadow, shadow_t_max, value, self.position))
+        let point = PointLight { position: self.position, intensity: self.intensity, attenuation: self.attenuation };
+        point.sample_within(at, |light_to_point| self.factor(light_to_point))
     }
 
     fn power(&self, _bounds: Bounds) -> Rgb {
