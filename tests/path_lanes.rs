@@ -210,6 +210,51 @@ fn more_than_sixteen_shapes_bit_for_bit() {
     assert!(lit > 1500, "only {lit} samples carried light");
 }
 
+/// A ball of `rings` × 2·`rings` flat facets (two triangles each, one at
+/// the poles), of `material`.
+fn faceted_ball(center: Vec3, radius: f32, rings: u32, material: &str) -> Vec<Object> {
+    let at = |ring: u32, step: u32| {
+        let (theta, phi) =
+            (std::f32::consts::PI * ring as f32 / rings as f32, std::f32::consts::PI * step as f32 / rings as f32);
+        center + radius * Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+    };
+    let mut objects = Vec::new();
+    for ring in 0..rings {
+        for step in 0..2 * rings {
+            let [a, b, c, d] = [at(ring, step), at(ring + 1, step), at(ring + 1, step + 1), at(ring, step + 1)];
+            let facets = [(a, c, b), (a, d, c)];
+            for (k, (a, b, c)) in facets.into_iter().enumerate() {
+                objects.push(Object {
+                    name: format!("{material} facet {ring} {step} {k} at {center}"),
+                    shape: Shape::Triangle { a, b, c },
+                    material: material.to_string(),
+                });
+            }
+        }
+    }
+    objects
+}
+
+/// The Cornell box with a faceted glass ball and a faceted white one: more
+/// triangles than a ray tests one by one, so every lane finds its
+/// triangle, and its shadow rays their blockers, through the hierarchy
+/// (`shapes::bvh`), the light's two triangles among them.
+fn cornell_of_facets() -> Scene {
+    let mut scene = preset("cornell");
+    scene.objects.extend(faceted_ball(Vec3::new(-0.35, 0.3, -0.2), 0.3, 8, "glass"));
+    scene.objects.extend(faceted_ball(Vec3::new(0.4, 0.25, 0.3), 0.25, 6, "white"));
+    scene
+}
+
+#[test]
+fn triangles_found_through_the_hierarchy_bit_for_bit() {
+    let scene = cornell_of_facets();
+    let (world, _) = world(&scene, 40, 30);
+    assert!(world.shapes.triangles.len() > gi_studio::render::world::shapes::GROUPED_TRIANGLES);
+    let lit = assert_lanes_match_scalar(&scene, 32, 2);
+    assert!(lit > 1500, "only {lit} samples carried light");
+}
+
 /// Paths that start outside a wall (a wide lens beside the Cornell box's
 /// right wall: some rays start beyond it) meet every plane from either
 /// side and test walls for their shadow rays, beside paths held inside.
@@ -303,6 +348,7 @@ fn shadow_rays_in_lanes_are_blocked_as_one_at_a_time() {
         Shape::Triangle { a: Vec3::new(-2.9, 2.4, -1.0), b: Vec3::new(-2.9, 2.4, 0.0), c: Vec3::new(-2.9, 1.6, -0.5) };
     lamps.objects.push(Object { name: "panel".into(), shape, ..lamps.objects[lamp].clone() });
     scenes.push(("gap-room with a panel".into(), lamps));
+    scenes.push(("cornell of facets".into(), cornell_of_facets()));
     for (name, scene) in &scenes {
         let (world, camera) = world(scene, 64, 48);
         let lanes = LaneWorld::new(&world).expect("a scene the lanes trace");

@@ -227,9 +227,7 @@ impl World {
     /// What can block the shadow rays of a path `held` inside every wall or not.
     #[inline]
     pub fn occluders(&self, held: bool) -> Occluders<'_> {
-        let s = self;
-        let triangles = (&s.shapes.triangles[..], &s.shapes.triangle_lanes);
-        Occluders::for_path(&s.walls, &s.shapes.spheres.lanes, &s.shapes.planes, triangles, &s.light_plane, held)
+        Occluders::for_path(&self.walls, &self.shapes, &self.light_plane, held)
     }
 
     /// Whether anything blocks `shadow` (tested against what can block it
@@ -275,7 +273,7 @@ impl World {
                 best = Some(Inside::Plane(&wall.plane));
             }
         }
-        let triangle_hit = self.shapes.triangle_lanes.nearest(&self.shapes.triangles, ray, best_t);
+        let triangle_hit = self.shapes.nearest_triangle(ray, best_t);
         if let Some((i, hit)) = triangle_hit {
             best_t = hit.t;
             best = Some(Inside::Triangle(i));
@@ -304,7 +302,7 @@ impl World {
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.shapes.spheres.lanes.any_hit(ray, t_max)
             || self.shapes.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
-            || self.shapes.triangle_lanes.any_hit(&self.shapes.triangles, ray, t_max, |_| false)
+            || self.shapes.any_triangle(ray, t_max, |_| false)
     }
 
     /// The world as a render through `camera` at width × height uses it

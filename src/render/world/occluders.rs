@@ -13,10 +13,10 @@ use glam::{DVec3, Vec3};
 
 use super::lanes::{F8, M8, V8};
 use super::light::{LightSample, LightSource};
-use super::shapes::{PlaneShape, SphereLanes, Spheres, TriangleLanes};
+use super::shapes::{PlaneShape, Shapes, SphereLanes, Spheres};
 use crate::geometry::sphere::AnchoredSphere;
+use crate::geometry::Ray;
 use crate::geometry::{gamma, plane_t};
-use crate::geometry::{Ray, Triangle};
 
 /// A region a wall bounds, in f64 for exact inside tests.
 #[derive(Clone, Copy, Debug)]
@@ -223,8 +223,8 @@ impl Walls {
 pub struct Occluders<'w> {
     spheres: &'w SphereLanes,
     planes: &'w [PlaneShape],
-    triangles: &'w [(Triangle, u32)],
-    triangle_lanes: &'w TriangleLanes,
+    /// The world's shapes, for its triangles.
+    shapes: &'w Shapes,
     /// Per triangle, the light triangle whose plane holds it (`u32::MAX` if none).
     light_plane: &'w [u32],
 }
@@ -233,16 +233,12 @@ impl<'w> Occluders<'w> {
     /// For a path that is `held` inside every wall (`Walls::hold` of where
     /// it started): without the walls.
     #[inline]
-    pub fn for_path(
-        walls: &'w Walls,
-        spheres: &'w SphereLanes,
-        planes: &'w [PlaneShape],
-        (triangles, triangle_lanes): (&'w [(Triangle, u32)], &'w TriangleLanes),
-        light_plane: &'w [u32],
-        held: bool,
-    ) -> Self {
-        let (spheres, planes) = if held { (&walls.spheres, &walls.planes[..]) } else { (spheres, planes) };
-        Occluders { spheres, planes, triangles, triangle_lanes, light_plane }
+    pub fn for_path(walls: &'w Walls, shapes: &'w Shapes, light_plane: &'w [u32], held: bool) -> Self {
+        let (spheres, planes) = match held {
+            true => (&walls.spheres, &walls.planes[..]),
+            false => (&shapes.spheres.lanes, &shapes.planes[..]),
+        };
+        Occluders { spheres, planes, shapes, light_plane }
     }
 
     /// Whether anything lies between the shading point and the light sample.
@@ -259,8 +255,7 @@ impl<'w> Occluders<'w> {
         let light_plane = shadow.on_triangle.map(|t| self.light_plane[t as usize]);
         self.spheres.any_hit_except(ray, t_max, shadow.on_sphere)
             || self.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
-            || (self.triangle_lanes)
-                .any_hit(self.triangles, ray, t_max, |i| light_plane == Some(self.light_plane[i as usize]))
+            || (self.shapes).any_triangle(ray, t_max, |i| light_plane == Some(self.light_plane[i as usize]))
     }
 }
 

@@ -17,6 +17,8 @@
 //! (the materials' own lanes are `materials::lanes`), and `wall_exits`
 //! asks a room of walls where a held ray leaves it.
 
+use std::sync::Arc;
+
 use glam::Vec3;
 
 mod draws;
@@ -37,7 +39,7 @@ use crate::geometry::Triangle;
 use crate::render::world::lanes::{self, Column, Column3, Index8, F8, LANES, M8, V8};
 use crate::render::world::light::{self, Emitter, LightSource};
 pub(crate) use crate::render::world::materials::lanes::{LaneSurfaces, MaterialTable, Scattered};
-use crate::render::world::shapes::{sphere::Sphere, ShapeIndex};
+use crate::render::world::shapes::{bvh::Bvh, sphere::Sphere, ShapeIndex};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::Rgb;
 
@@ -131,6 +133,9 @@ pub struct LaneWorld {
     /// where the triangle and a list of runs beside it took several, each
     /// with its bounds check.
     triangle_culls: Vec<LaneCull>,
+    /// The world's hierarchy over its triangles, where it has one: each
+    /// lane's ray finds its triangle through it, as the scalar code does.
+    triangle_bvh: Option<Arc<Bvh>>,
     /// Each triangle's light plane (`World::light_plane`): a shadow ray
     /// toward a light on a triangle skips the triangles of its plane.
     triangle_planes: Vec<u32>,
@@ -228,6 +233,7 @@ impl LaneWorld {
             planes,
             triangles: world.shapes.triangles.iter().map(|(triangle, _)| *triangle).collect(),
             triangle_culls: lane_culls(&world.shapes.triangles),
+            triangle_bvh: world.shapes.triangle_bvh.clone(),
             triangle_planes: world.light_plane.clone(),
             surfaces,
             lights: LaneLights::new(world),

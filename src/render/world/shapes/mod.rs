@@ -6,15 +6,19 @@
 //! - `triangle`: triangles four to a SIMD group behind a test of where the
 //!   ray crosses their plane.
 
+pub mod bvh;
 pub mod plane;
 pub mod sphere;
 pub mod triangle;
 
+use std::sync::Arc;
+
 use glam::{DVec3, Vec2, Vec3};
 
 use crate::geometry::real::{Real, V3};
-use crate::geometry::{SurfaceHit, Triangle};
+use crate::geometry::{Ray, SurfaceHit, Triangle};
 use crate::scene::Shape;
+use bvh::Bvh;
 pub use plane::PlaneShape;
 use sphere::Sphere;
 pub use sphere::{CappedSphere, EmitterCap, SphereLanes, Spheres};
@@ -120,8 +124,25 @@ pub struct Shapes {
     pub spheres: Spheres,
     pub planes: Vec<PlaneShape>,
     pub triangles: Vec<(Triangle, u32)>,
-    /// The same triangles four to a SIMD group, for the hit loops.
+    /// The same triangles four to a SIMD group, for the hit loops, in a
+    /// scene of a few of them.
     pub(crate) triangle_lanes: TriangleLanes,
+    /// A hierarchy over them, for a scene of many (`GROUPED_TRIANGLES`).
+    pub(crate) triangle_bvh: Option<Arc<Bvh>>,
+}
+
+/// Up to how many triangles a ray tests them all, four at a time, rather
+/// than find them through a hierarchy.
+pub const GROUPED_TRIANGLES: usize = 64;
+
+/// Each triangle's box.
+fn triangle_boxes(triangles: &[(Triangle, u32)]) -> Vec<(Vec3, Vec3)> {
+    (triangles.iter())
+        .map(|(t, _)| {
+            let [a, b, c] = t.vertices;
+            (a.min(b.min(c)), a.max(b.max(c)))
+        })
+        .collect()
 }
 
 /// Where each kind starts when every shape is counted once, kind by kind in
@@ -155,18 +176,37 @@ impl Shapes {
             })
             .collect();
         Triangle::share_planes(&mut triangles.iter_mut().map(|(triangle, _)| triangle).collect::<Vec<_>>());
-        let triangle_lanes = TriangleLanes::new(&triangles);
-        (Shapes { spheres: Spheres::new(spheres), planes, triangles, triangle_lanes }, refs)
+        let (triangle_lanes, triangle_bvh) = match triangles.len() > GROUPED_TRIANGLES {
+            true => (TriangleLanes::default(), Some(Arc::new(Bvh::new(&triangle_boxes(&triangles))))),
+            false => (TriangleLanes::new(&triangles), None),
+        };
+        (Shapes { spheres: Spheres::new(spheres), planes, triangles, triangle_lanes, triangle_bvh }, refs)
+    }
+
+    /// The nearest triangle on the ray within (0, t_max) and the hit:
+    /// what `intersect_triangle` over the triangles finds.
+    #[inline]
+    pub fn nearest_triangle(&self, ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
+        match &self.triangle_bvh {
+            Some(bvh) => triangle::nearest_in(bvh, |i| &self.triangles[i as usize].0, ray, t_max),
+            None => self.triangle_lanes.nearest(&self.triangles, ray, t_max),
+        }
+    }
+
+    /// Whether any triangle but those `skip` names lies on the ray within
+    /// (0, t_max).
+    #[inline]
+    pub fn any_triangle(&self, ray: &Ray, t_max: f32, skip: impl Fn(u32) -> bool) -> bool {
+        match &self.triangle_bvh {
+            Some(bvh) => triangle::any_in(bvh, |i| &self.triangles[i as usize].0, ray, t_max, skip),
+            None => self.triangle_lanes.any_hit(&self.triangles, ray, t_max, skip),
+        }
     }
 
     /// The box about every finite shape (`None` without any): (low, high).
     pub fn finite_box(&self) -> Option<(Vec3, Vec3)> {
         let spheres = self.spheres.list.iter().map(|s| (s.center - s.radius, s.center + s.radius));
-        let triangles = (self.triangles.iter()).map(|(t, _)| {
-            let [a, b, c] = t.vertices;
-            (a.min(b.min(c)), a.max(b.max(c)))
-        });
-        let (lo, hi) = (spheres.chain(triangles))
+        let (lo, hi) = (spheres.chain(triangle_boxes(&self.triangles)))
             .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (l, h)| (lo.min(l), hi.max(h)));
         (lo.x <= hi.x).then_some((lo, hi))
     }

@@ -11,6 +11,7 @@
 
 use glam::{BVec4A, DVec3, Vec2, Vec3, Vec4};
 
+use super::bvh::Bvh;
 use super::{solid_angle_pdf, AreaEmitter};
 use crate::geometry::real::{Real, V3};
 use crate::geometry::{
@@ -204,6 +205,31 @@ impl TriangleLanes {
             false
         })
     }
+}
+
+/// The nearest of the triangles `bvh` holds (`triangle` gives each) on
+/// the ray within (0, t_max), and the hit: `intersect_triangle`'s.
+#[inline]
+pub fn nearest_in<'t>(
+    bvh: &Bvh,
+    triangle: impl Fn(u32) -> &'t Triangle,
+    ray: &Ray,
+    t_max: f32,
+) -> Option<(u32, SurfaceHit)> {
+    bvh.nearest(ray, t_max, |i, best_t| intersect_triangle(ray, triangle(i), best_t).map(|hit| (hit.t, hit)))
+}
+
+/// Whether any triangle `bvh` holds but those `skip` names lies on the ray
+/// within (0, t_max).
+#[inline]
+pub fn any_in<'t>(
+    bvh: &Bvh,
+    triangle: impl Fn(u32) -> &'t Triangle,
+    ray: &Ray,
+    t_max: f32,
+    skip: impl Fn(u32) -> bool,
+) -> bool {
+    bvh.any_hit(ray, t_max, |i| !skip(i) && intersect_triangle(ray, triangle(i), t_max).is_some())
 }
 
 /// The point of barycentrics (b0, b1, 1 − b0 − b1) on a triangle, for one
