@@ -24,13 +24,13 @@ use camera::CameraModel;
 use light::{Emitter, LightSource};
 use occluders::{Occluders, Shadow, WallPlane, Walls};
 use shapes::sphere::Sphere;
-use shapes::{EmitterCap, SphereLanes};
+use shapes::{EmitterCap, SphereReach};
 pub use shapes::{ObjectInfo, PlaneShape, ShapeRef, Shapes, Spheres};
 
 /// What `intersect_held` found nearest.
 /// What `World::reach` gives a ray to meet.
 struct Reach<'w> {
-    spheres: &'w SphereLanes,
+    spheres: SphereReach<'w>,
     wall_spheres: &'w [(u32, AnchoredSphere)],
     planes: &'w [PlaneShape],
     wall_planes: &'w [WallPlane],
@@ -202,13 +202,13 @@ impl World {
         let walls = &self.walls;
         match held {
             true => Reach {
-                spheres: &walls.spheres,
+                spheres: SphereReach::Groups(&walls.spheres),
                 wall_spheres: &walls.wall_spheres,
                 planes: &walls.planes,
                 wall_planes: &walls.wall_planes,
             },
             false => Reach {
-                spheres: &self.shapes.spheres.lanes,
+                spheres: SphereReach::All(&self.shapes.spheres),
                 wall_spheres: &[],
                 planes: &self.shapes.planes,
                 wall_planes: &[],
@@ -250,7 +250,7 @@ impl World {
         let mut best = None;
         if let Some((i, t, near)) = reach.spheres.nearest(ray, best_t) {
             best_t = t;
-            best = Some(Inside::Sphere(reach.spheres.id(i), near));
+            best = Some(Inside::Sphere(i, near));
         }
         let (origin, direction) = (V3::from(ray.origin), V3::from(ray.direction));
         for (k, (_, wall)) in reach.wall_spheres.iter().enumerate() {
@@ -300,7 +300,7 @@ impl World {
     /// first blocker.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.shapes.spheres.lanes.any_hit(ray, t_max)
+        SphereReach::All(&self.shapes.spheres).any_hit_except(ray, t_max, None)
             || self.shapes.planes.iter().any(|p| plane_t(ray, p.normal, p.offset, t_max).is_some())
             || self.shapes.any_triangle(ray, t_max, |_| false)
     }

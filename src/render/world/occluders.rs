@@ -13,7 +13,7 @@ use glam::{DVec3, Vec3};
 
 use super::lanes::{F8, M8, V8};
 use super::light::{LightSample, LightSource};
-use super::shapes::{PlaneShape, Shapes, SphereLanes, Spheres};
+use super::shapes::{PlaneShape, Shapes, SphereLanes, SphereReach, Spheres};
 use crate::geometry::sphere::AnchoredSphere;
 use crate::geometry::Ray;
 use crate::geometry::{gamma, plane_t};
@@ -125,6 +125,11 @@ impl Walls {
         lights: &[LightSource],
         eye: Vec3,
     ) -> Self {
+        if spheres.bvh.is_some() {
+            // A room's walls save a few of a handful of tests a ray; where
+            // the spheres are many, the hierarchy finds them, walls or not
+            return Walls::default();
+        }
         let eye_f32 = eye;
         let eye = eye.as_dvec3();
         let is_wall = |region: &Region, object: u32| {
@@ -221,7 +226,7 @@ impl Walls {
 /// What can block the shadow rays of one path.
 #[derive(Clone, Copy)]
 pub struct Occluders<'w> {
-    spheres: &'w SphereLanes,
+    spheres: SphereReach<'w>,
     planes: &'w [PlaneShape],
     /// The world's shapes, for its triangles.
     shapes: &'w Shapes,
@@ -235,8 +240,8 @@ impl<'w> Occluders<'w> {
     #[inline]
     pub fn for_path(walls: &'w Walls, shapes: &'w Shapes, light_plane: &'w [u32], held: bool) -> Self {
         let (spheres, planes) = match held {
-            true => (&walls.spheres, &walls.planes[..]),
-            false => (&shapes.spheres.lanes, &shapes.planes[..]),
+            true => (SphereReach::Groups(&walls.spheres), &walls.planes[..]),
+            false => (SphereReach::All(&shapes.spheres), &shapes.planes[..]),
         };
         Occluders { spheres, planes, shapes, light_plane }
     }

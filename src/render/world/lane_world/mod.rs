@@ -163,10 +163,12 @@ pub struct LaneWorld {
 
 impl LaneWorld {
     /// For worlds of spheres, planes and triangles on a CPU that runs the
-    /// lanes (`None` for a world of none, or a CPU without AVX2).
+    /// lanes (`None` for a world of none, one of more spheres than they
+    /// test one by one, or a CPU without AVX2).
     pub fn new(world: &World) -> Option<Self> {
-        // Its methods run AVX2 without asking again
-        if !lanes::supported() {
+        // Its methods run AVX2 without asking again. Spheres in a hierarchy
+        // (a scene of many) are left to the scalar code, which finds them there
+        if !lanes::supported() || world.shapes.spheres.bvh.is_some() {
             return None;
         }
         let s = &world.shapes.spheres;

@@ -21,7 +21,7 @@ use crate::scene::Shape;
 use bvh::Bvh;
 pub use plane::PlaneShape;
 use sphere::Sphere;
-pub use sphere::{CappedSphere, EmitterCap, SphereLanes, Spheres};
+pub use sphere::{CappedSphere, EmitterCap, SphereLanes, SphereReach, Spheres};
 pub use triangle::TriangleLanes;
 
 /// What a shape that can be an area light answers, written once per kind;

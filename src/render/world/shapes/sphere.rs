@@ -4,11 +4,14 @@
 //! which emits from a cap of it (`EmitterCap`) and is sampled by the cone
 //! it subtends.
 
+use std::sync::Arc;
+
 use glam::{BVec4A, DVec3, Vec2, Vec3, Vec4};
 
+use super::bvh::Bvh;
 use super::{solid_angle_pdf, AreaEmitter};
 use crate::geometry::real::{Real, V3};
-use crate::geometry::sphere::nearest_root;
+use crate::geometry::sphere::{nearest_root, sphere_t};
 use crate::geometry::{frame_from_z, gamma, to_world, Frame, Ray, SurfaceHit};
 use crate::render::world::sampling::{sin_cos_of, uniform_cone, uniform_cone_pdf, uniform_sphere};
 
@@ -29,21 +32,87 @@ impl Sphere {
     }
 }
 
-/// The world's spheres, in order, and the same four to a SIMD group.
+/// The world's spheres, in order, four to a SIMD group, and in a
+/// hierarchy where there are many.
 #[derive(Clone, Debug, Default)]
 pub struct Spheres {
     pub list: Vec<Sphere>,
-    /// The same spheres four to a SIMD group, for the hit loops.
+    /// The same spheres four to a SIMD group, for the hit loops (empty
+    /// where `bvh` holds them).
     pub lanes: SphereLanes,
+    /// A hierarchy over them, for a scene of many (`GROUPED_SPHERES`).
+    pub bvh: Option<Arc<Bvh>>,
+}
+
+/// Up to how many spheres a ray tests them all, four at a time, rather
+/// than find them through a hierarchy.
+pub const GROUPED_SPHERES: usize = 64;
+
+/// Which spheres a ray meets: all of the world's, or a group's (the
+/// spheres that are not walls, for paths held inside them).
+#[derive(Clone, Copy, Debug)]
+pub enum SphereReach<'w> {
+    All(&'w Spheres),
+    Groups(&'w SphereLanes),
+}
+
+impl SphereReach<'_> {
+    /// Nearest hit in (0, t_max): (the world's sphere index, t, near root).
+    #[inline]
+    pub fn nearest(&self, ray: &Ray, t_max: f32) -> Option<(u32, f32, bool)> {
+        let groups = match *self {
+            SphereReach::All(Spheres { bvh: Some(bvh), list, .. }) => {
+                let hit = |i: u32, best_t| {
+                    let sphere = &list[i as usize];
+                    sphere_t(ray, sphere.center, sphere.radius, best_t).map(|(t, near)| (t, (t, near)))
+                };
+                return bvh.nearest(ray, t_max, hit).map(|(i, (t, near))| (i, t, near));
+            }
+            SphereReach::All(spheres) => &spheres.lanes,
+            SphereReach::Groups(groups) => groups,
+        };
+        let (i, t, near) = groups.nearest(ray, t_max)?;
+        Some((groups.id(i), t, near))
+    }
+
+    /// Whether any sphere but the world's sphere `except` lies on the ray
+    /// in (0, t_max).
+    #[inline]
+    pub fn any_hit_except(&self, ray: &Ray, t_max: f32, except: Option<u32>) -> bool {
+        match *self {
+            SphereReach::All(Spheres { bvh: Some(bvh), list, .. }) => bvh.any_hit(ray, t_max, |i| {
+                let sphere = &list[i as usize];
+                Some(i) != except && sphere_t(ray, sphere.center, sphere.radius, t_max).is_some()
+            }),
+            SphereReach::All(spheres) => spheres.lanes.any_hit_except(ray, t_max, except),
+            SphereReach::Groups(groups) => groups.any_hit_except(ray, t_max, except),
+        }
+    }
+
+    /// How many spheres it holds.
+    pub fn len(&self) -> usize {
+        match self {
+            SphereReach::All(spheres) => spheres.len(),
+            SphereReach::Groups(groups) => groups.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 }
 
 impl Spheres {
     /// Of `list`, in order.
     pub fn new(list: Vec<Sphere>) -> Self {
+        if list.len() > GROUPED_SPHERES {
+            let boxes: Vec<(Vec3, Vec3)> = list.iter().map(|s| (s.center - s.radius, s.center + s.radius)).collect();
+            return Spheres { bvh: Some(Arc::new(Bvh::new(&boxes))), list, lanes: SphereLanes::default() };
+        }
         let centers: Vec<Vec3> = list.iter().map(|s| s.center).collect();
         let radii: Vec<f32> = list.iter().map(|s| s.radius).collect();
         let lanes = SphereLanes::new(&centers, &radii, (0..list.len() as u32).collect());
-        Spheres { list, lanes }
+        Spheres { list, lanes, bvh: None }
     }
 
     #[inline]
@@ -346,7 +415,6 @@ impl SphereLanes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::sphere_t;
     use crate::render::world::rng::Sampler;
 
     /// Four-wide lanes agree with the scalar test, sphere by sphere.
@@ -496,5 +564,48 @@ mod tests {
             }
         }
         assert!(missed > 0, "no edge ray missed: the fallback was not exercised");
+    }
+
+    /// Past `GROUPED_SPHERES` the spheres are found through a hierarchy:
+    /// the same nearest sphere, t and root as testing every one in order
+    /// (`sphere_t`), and any hit, with or without one sphere, exactly where
+    /// there is one.
+    #[test]
+    fn many_spheres_are_found_as_testing_each_finds_them() {
+        let mut s = Sampler::new(0, 0, 55);
+        let list: Vec<Sphere> = (0..500)
+            .map(|object| {
+                let center = uniform_sphere(s.next_2d()) * 6.0 * s.next_f32();
+                Sphere { center, radius: 0.05 + 0.4 * s.next_f32(), object }
+            })
+            .collect();
+        let spheres = Spheres::new(list.clone());
+        assert!(spheres.bvh.is_some() && spheres.lanes.is_empty());
+        let reach = SphereReach::All(&spheres);
+        let (mut hits, mut misses) = (0, 0);
+        for k in 0..4000 {
+            let origin = uniform_sphere(s.next_2d()) * 9.0 * s.next_f32();
+            let direction = match k % 2 {
+                0 => (list[k % list.len()].center - origin).normalize(),
+                _ => uniform_sphere(s.next_2d()),
+            };
+            let ray = Ray::new(origin, direction);
+            let t_max = if k % 3 == 0 { 3.0 } else { f32::INFINITY };
+            let mut expected: Option<(u32, f32, bool)> = None;
+            for (i, sphere) in list.iter().enumerate() {
+                let best = expected.map_or(t_max, |e| e.1);
+                if let Some((t, near)) = sphere_t(&ray, sphere.center, sphere.radius, best) {
+                    expected = Some((i as u32, t, near));
+                }
+            }
+            assert_eq!(reach.nearest(&ray, t_max), expected, "ray {ray:?}");
+            let except = (k % list.len()) as u32;
+            let others = (list.iter().enumerate())
+                .any(|(i, o)| i as u32 != except && sphere_t(&ray, o.center, o.radius, t_max).is_some());
+            assert_eq!(reach.any_hit_except(&ray, t_max, Some(except)), others);
+            assert_eq!(reach.any_hit_except(&ray, t_max, None), expected.is_some());
+            (hits, misses) = (hits + expected.is_some() as u32, misses + expected.is_none() as u32);
+        }
+        assert!(hits > 1500 && misses > 500, "{hits} hits, {misses} misses");
     }
 }
