@@ -96,6 +96,10 @@ pub const SPPM_ALPHA: Limit<f32> = Limit::above(0.0, 1.0);
 pub const STORED_PHOTONS: u64 = 200_000_000;
 /// Scene files, the studio's state file and reference metadata.
 pub const TEXT_FILE_BYTES: u64 = 16 << 20;
+/// A mesh file (OBJ or PLY).
+pub const MESH_FILE_BYTES: u64 = 256 << 20;
+/// Triangles in one scene's meshes, all told.
+pub const MESH_TRIANGLES: usize = 10_000_000;
 /// The reference cache's size; the least recently used go beyond it.
 pub const REFERENCE_CACHE_BYTES: u64 = 512 << 20;
 

@@ -111,6 +111,7 @@ fn random_scene() -> impl Strategy<Value = Scene> {
                             enabled,
                         })
                         .collect(),
+                    meshes: Default::default(),
                 }
             },
         )

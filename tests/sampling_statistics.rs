@@ -139,7 +139,7 @@ fn light_pdf_toward(light: &LightSource, world: &World, at: Vec3, d: Vec3) -> f6
         gi_studio::render::world::ShapeRef::Triangle(t) => {
             intersect_triangle(&ray, &world.shapes.triangles[t as usize].0, f32::INFINITY)
         }
-        gi_studio::render::world::ShapeRef::Plane(_) => None,
+        gi_studio::render::world::ShapeRef::Plane(_) | gi_studio::render::world::ShapeRef::Mesh { .. } => None,
     };
     hit.map_or(0.0, |hit| light.pdf(at, &hit) as f64)
 }

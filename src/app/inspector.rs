@@ -219,6 +219,7 @@ fn shape_name(shape: &Shape) -> &'static str {
         Shape::Sphere { .. } => "sphere",
         Shape::Plane { .. } => "plane",
         Shape::Triangle { .. } => "triangle",
+        Shape::Mesh { .. } => "mesh",
     }
 }
 
@@ -324,6 +325,13 @@ fn properties_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection
                     changed |= vec3_ui(ui, "A", a, 0.01);
                     changed |= vec3_ui(ui, "B", b, 0.01);
                     changed |= vec3_ui(ui, "C", c, 0.01);
+                }
+                Shape::Mesh { file, translate, scale, rotate_degrees } => {
+                    let triangles = scene.meshes.get(file).map_or(0, |mesh| mesh.triangles.len());
+                    ui.label(format!("File: {file} ({triangles} triangles)"));
+                    changed |= vec3_ui(ui, "Translate", translate, 0.01);
+                    changed |= scalar_ui(ui, "Scale", scale, 1e-6..=f32::MAX, 0.01);
+                    changed |= vec3_ui(ui, "Rotate (°)", rotate_degrees, 0.5);
                 }
             }
         }

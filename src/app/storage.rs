@@ -198,7 +198,8 @@ pub struct AutosaveOffer {
 /// The autosaved scene, if it parses and differs from `scene`: what a
 /// crashed session left unsaved.
 pub fn autosave_offer(autosaved: Option<String>, scene: &Scene) -> Option<AutosaveOffer> {
-    let valid = crate::scene::parse_scene(&autosaved?, Path::new("autosave.ron")).ok()?;
+    // Meshes are read back as the scene the studio opened on holds them
+    let valid = crate::scene::parse_scene_with(&autosaved?, Path::new("autosave.ron"), &scene.meshes).ok()?;
     let offered = valid.into_scene();
     let edits = crate::scene::differences(scene, &offered, 6);
     (!edits.is_empty()).then_some(AutosaveOffer { scene: offered, edits })

@@ -26,7 +26,7 @@ pub fn unseen_lights(scene: &Scene, algorithm: Algorithm) -> Vec<String> {
             let material = scene.material_index(&object.material).map(|m| &scene.materials[m].model);
             let inside = match object.shape {
                 Shape::Sphere { center, radius } => (position - center).length() < radius,
-                Shape::Plane { .. } | Shape::Triangle { .. } => false,
+                Shape::Plane { .. } | Shape::Triangle { .. } | Shape::Mesh { .. } => false,
             };
             inside && matches!(material, Some(MaterialModel::Glass { .. }))
         });

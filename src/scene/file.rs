@@ -3,7 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Invalid, Scene, ValidScene};
+use std::sync::Arc;
+
+use super::mesh::{load_mesh, MeshError, Meshes};
+use super::{Invalid, Problem, Scene, Shape, ValidScene};
 use crate::fileio::{self, FileError};
 use crate::limits;
 
@@ -20,6 +23,9 @@ pub enum SceneFileError {
     Invalid { path: PathBuf, line: usize, column: usize, invalid: Box<Invalid>, others: usize },
     #[error("could not write the scene: {0}")]
     Serialize(String),
+    /// A mesh the scene names could not be read; the position is its `file`.
+    #[error("{path}:{line}:{column}: {error}")]
+    Mesh { path: PathBuf, line: usize, column: usize, error: Box<MeshError> },
 }
 
 fn more_note(others: usize) -> String {
@@ -36,14 +42,22 @@ pub fn load_scene(path: &Path) -> Result<ValidScene, SceneFileError> {
     parse_scene(&text, path)
 }
 
-/// Parse and validate scene text; `path` is only used in messages.
+/// Parse and validate scene text, reading the meshes it names from beside
+/// `path`.
 pub fn parse_scene(text: &str, path: &Path) -> Result<ValidScene, SceneFileError> {
-    let scene: Scene = ron::Options::default().from_str(text).map_err(|e| SceneFileError::Syntax {
+    parse_scene_with(text, path, &Meshes::default())
+}
+
+/// `parse_scene`, taking the meshes `loaded` holds from it rather than
+/// from their files (an autosave read back beside the scene it was made from).
+pub fn parse_scene_with(text: &str, path: &Path, loaded: &Meshes) -> Result<ValidScene, SceneFileError> {
+    let mut scene: Scene = ron::Options::default().from_str(text).map_err(|e| SceneFileError::Syntax {
         path: path.to_owned(),
         line: e.span.start.line,
         column: e.span.start.col,
         message: e.code.to_string(),
     })?;
+    load_meshes(&mut scene, text, path, loaded)?;
     let mut problems = match ValidScene::new(scene) {
         Ok(valid) => return Ok(valid),
         Err(problems) => problems,
@@ -52,6 +66,42 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<ValidScene, SceneFileError
     let invalid = problems.swap_remove(0);
     let (line, column) = locate(text, &invalid);
     Err(SceneFileError::Invalid { path: path.to_owned(), line, column, invalid: Box::new(invalid), others })
+}
+
+/// Read each mesh file the scene's objects name, once, from beside `path`
+/// (or take it from `loaded`), within `limits::MESH_TRIANGLES` all told.
+fn load_meshes(scene: &mut Scene, text: &str, path: &Path, loaded: &Meshes) -> Result<(), SceneFileError> {
+    let folder = path.parent().unwrap_or(Path::new(""));
+    for (index, object) in scene.objects.iter().enumerate() {
+        let Shape::Mesh { file, .. } = &object.shape else { continue };
+        if scene.meshes.get(file).is_some() {
+            continue;
+        }
+        let mesh = match loaded.get(file) {
+            Some(mesh) => Ok(mesh.clone()),
+            None => load_mesh(&folder.join(file)).map(Arc::new),
+        };
+        let mesh = mesh.and_then(|mesh| match scene.meshes.triangles() + mesh.triangles.len() {
+            count if count > limits::MESH_TRIANGLES => Err(MeshError::TooMany { path: folder.join(file), count }),
+            _ => Ok(mesh),
+        });
+        match mesh {
+            Ok(mesh) => scene.meshes.insert(file.clone(), mesh),
+            Err(error) => {
+                let at = Invalid {
+                    field: String::new(),
+                    section: "objects",
+                    index: Some(index),
+                    item: None,
+                    key: "file",
+                    problem: Problem::MeshNotLoaded(String::new()),
+                };
+                let (line, column) = locate(text, &at);
+                return Err(SceneFileError::Mesh { path: path.to_owned(), line, column, error: Box::new(error) });
+            }
+        }
+    }
+    Ok(())
 }
 
 pub fn to_ron(scene: &Scene) -> Result<String, SceneFileError> {

@@ -4,12 +4,13 @@
 
 mod differences;
 mod file;
+pub mod mesh;
 pub mod presets;
 mod valid;
 mod validate;
 
 pub use differences::{differences, shown as shown_name};
-pub use file::{load_scene, parse_scene, save_scene, to_ron, SceneFileError};
+pub use file::{load_scene, parse_scene, parse_scene_with, save_scene, to_ron, SceneFileError};
 pub use valid::ValidScene;
 pub use validate::{Invalid, Problem};
 
@@ -36,6 +37,10 @@ pub struct Scene {
     pub objects: Vec<Object>,
     #[serde(default)]
     pub lights: Vec<Light>,
+    /// The files its meshes name, loaded (by the scene file's loader, or
+    /// the studio's import); not part of its text.
+    #[serde(skip)]
+    pub meshes: mesh::Meshes,
 }
 
 /// A pinhole or thin-lens camera.
@@ -188,6 +193,37 @@ pub enum Shape {
         b: Vec3,
         c: Vec3,
     },
+    /// The triangles of an OBJ or PLY file (its path relative to the scene
+    /// file's folder), scaled by `scale` about the file's origin, turned by
+    /// `rotate_degrees` about x, then y, then z, then moved by `translate`.
+    Mesh {
+        file: String,
+        #[serde(default)]
+        translate: Vec3,
+        #[serde(default = "unit_scale")]
+        scale: f32,
+        #[serde(default)]
+        rotate_degrees: Vec3,
+    },
+}
+
+fn unit_scale() -> f32 {
+    1.0
+}
+
+impl Shape {
+    /// Where a mesh's file puts a point (`Mesh`'s placement); the point
+    /// itself for any other shape.
+    pub fn place(&self, point: Vec3) -> Vec3 {
+        match *self {
+            Shape::Mesh { translate, scale, rotate_degrees, .. } => {
+                let r = rotate_degrees * (std::f32::consts::PI / 180.0);
+                let rotation = glam::Quat::from_euler(glam::EulerRot::ZYX, r.z, r.y, r.x);
+                rotation * (point * scale) + translate
+            }
+            _ => point,
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -67,6 +67,7 @@ fn fallback_scene() -> Scene {
             attenuation: Default::default(),
             enabled: true,
         }],
+        meshes: Default::default(),
     }
 }
 

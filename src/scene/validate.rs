@@ -51,6 +51,10 @@ pub enum Problem {
     DuplicateName(String),
     #[error("must not be empty")]
     EmptyName,
+    #[error("the mesh file \"{0}\" is not loaded (open the scene from its file, beside the mesh)")]
+    MeshNotLoaded(String),
+    #[error("a mesh cannot be an emissive light yet: make its material not Emissive, or build the light of triangles")]
+    EmissiveMesh,
     #[error("{width} × {height} is more than the {} pixels an image may have", limits::IMAGE_PIXELS)]
     TooManyPixels { width: u32, height: u32 },
 }
@@ -232,6 +236,18 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
                 check.vector("a", *a);
                 check.vector("b", *b);
                 check.vector("c", *c);
+            }
+            Shape::Mesh { file, translate, scale, rotate_degrees } => {
+                if scene.meshes.get(file).is_none() {
+                    check.report("file", Problem::MeshNotLoaded(shown_name(file)));
+                }
+                check.vector("translate", *translate);
+                check.positive("scale", *scale);
+                check.vector("rotate_degrees", *rotate_degrees);
+                let material = scene.material_index(&object.material).map(|m| &scene.materials[m].model);
+                if matches!(material, Some(MaterialModel::Emissive { .. })) {
+                    check.report("file", Problem::EmissiveMesh);
+                }
             }
         }
     }

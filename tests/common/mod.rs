@@ -51,6 +51,7 @@ pub fn scene(camera: Camera, materials: Vec<Material>, objects: Vec<Object>, lig
         materials,
         objects,
         lights,
+        meshes: Default::default(),
     }
 }
 

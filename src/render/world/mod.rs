@@ -128,7 +128,8 @@ fn nearest_nine_tenths(points: &[Vec3]) -> Vec<Vec3> {
 impl World {
     /// Compile a scene for rendering.
     pub fn new(scene: &ValidScene) -> Self {
-        let (shapes, refs) = Shapes::new(scene.objects.iter().zip(0..).map(|(object, id)| (&object.shape, id)));
+        let objects = scene.objects.iter().zip(0..).map(|(object, id)| (&object.shape, id));
+        let (shapes, refs) = Shapes::new(objects, &scene.meshes);
         let mut world = World {
             shapes,
             objects: Vec::with_capacity(scene.objects.len()),

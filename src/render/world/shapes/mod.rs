@@ -17,6 +17,7 @@ use glam::{DVec3, Vec2, Vec3};
 
 use crate::geometry::real::{Real, V3};
 use crate::geometry::{Ray, SurfaceHit, Triangle};
+use crate::scene::mesh::Meshes;
 use crate::scene::Shape;
 use bvh::Bvh;
 pub use plane::PlaneShape;
@@ -156,7 +157,7 @@ pub struct ShapeIndex {
 impl Shapes {
     /// Of the objects' `shapes` (in order, the object's index beside each),
     /// and where each one went.
-    pub fn new<'s>(shapes: impl Iterator<Item = (&'s Shape, u32)>) -> (Self, Vec<ShapeRef>) {
+    pub fn new<'s>(shapes: impl Iterator<Item = (&'s Shape, u32)>, meshes: &Meshes) -> (Self, Vec<ShapeRef>) {
         let (mut spheres, mut planes, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
         let refs = shapes
             .map(|(shape, object)| match *shape {
@@ -172,6 +173,14 @@ impl Shapes {
                 Shape::Triangle { a, b, c } => {
                     triangles.push((Triangle::new(a, b, c), object));
                     ShapeRef::Triangle(triangles.len() as u32 - 1)
+                }
+                Shape::Mesh { ref file, .. } => {
+                    // A valid scene has every mesh it names loaded
+                    let first = triangles.len() as u32;
+                    let loaded = meshes.get(file).map_or(&[][..], |mesh| &mesh.triangles[..]);
+                    let placed = |t: &[Vec3; 3]| Triangle::new(shape.place(t[0]), shape.place(t[1]), shape.place(t[2]));
+                    triangles.extend(loaded.iter().map(|t| (placed(t), object)));
+                    ShapeRef::Mesh { first, count: triangles.len() as u32 - first }
                 }
             })
             .collect();
@@ -223,7 +232,7 @@ impl Shapes {
                 let triangle = self.triangles[t as usize].0;
                 (!triangle.is_degenerate()).then_some(Emitter::Triangle { triangle: t, shape: triangle })
             }
-            ShapeRef::Plane(_) => None,
+            ShapeRef::Plane(_) | ShapeRef::Mesh { .. } => None,
         }
     }
 
@@ -236,6 +245,12 @@ impl Shapes {
                 let center = (a + b + c) / 3.0;
                 let radius = (a - center).length().max((b - center).length()).max((c - center).length());
                 Some((center, radius * 1.001))
+            }
+            ShapeRef::Mesh { first, count } => {
+                let triangles = &self.triangles[first as usize..(first + count) as usize];
+                let (lo, hi) = (triangle_boxes(triangles).into_iter())
+                    .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (l, h)| (lo.min(l), hi.max(h)));
+                (lo.x <= hi.x).then(|| ((lo + hi) * 0.5, (hi - lo).length() * 0.5 * 1.001))
             }
             ShapeRef::Plane(_) => None,
         }
@@ -277,6 +292,11 @@ pub enum ShapeRef {
     Sphere(u32),
     Plane(u32),
     Triangle(u32),
+    /// A mesh's `count` triangles from `first` on.
+    Mesh {
+        first: u32,
+        count: u32,
+    },
 }
 
 #[derive(Clone, Copy, Debug)]
