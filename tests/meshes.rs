@@ -154,6 +154,12 @@ fn a_placed_mesh_renders_as_its_triangles_typed_one_by_one() {
     write(dir.path(), "cube.obj", cube_obj());
     let (path, typed) = cube_scenes(dir.path(), "cube.obj");
     let loaded = load_scene(&path).expect("the scene beside its mesh");
+    // Photon maps and references are tied to the mesh's content, not its name
+    write(dir.path(), "cube.obj", cube_obj().replace("v 1 1 1", "v 1 1 1.5"));
+    let changed = load_scene(&path).expect("the scene beside its changed mesh");
+    assert_ne!(loaded.content_key(), changed.content_key());
+    write(dir.path(), "cube.obj", cube_obj());
+    assert_eq!(load_scene(&path).expect("the scene again").content_key(), loaded.content_key());
     for algorithm in [Algorithm::Path, Algorithm::Bdpt] {
         let (mesh, triangles) = (render(loaded.clone(), algorithm), render(typed.clone(), algorithm));
         assert!(mesh.pixels == triangles.pixels, "{algorithm:?}: the mesh's image is not its triangles'");

@@ -22,6 +22,16 @@ use crate::limits;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshData {
     pub triangles: Vec<[Vec3; 3]>,
+    /// FNV-1a of the triangles' bits: what `Scene::content_key` holds of it.
+    pub key: u64,
+}
+
+impl MeshData {
+    pub fn new(triangles: Vec<[Vec3; 3]>) -> Self {
+        let bits = triangles.iter().flatten().flat_map(|v| v.to_array()).flat_map(|c| c.to_bits().to_le_bytes());
+        let key = bits.fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+        MeshData { triangles, key }
+    }
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -58,6 +68,11 @@ impl Meshes {
         self.0.insert(file, mesh);
     }
 
+    /// Each mesh's key (`MeshData::key`), in the order of their names.
+    pub fn keys(&self) -> impl Iterator<Item = u64> + '_ {
+        self.0.values().map(|mesh| mesh.key)
+    }
+
     /// Triangles in every mesh held.
     pub fn triangles(&self) -> usize {
         self.0.values().map(|mesh| mesh.triangles.len()).sum()
@@ -79,7 +94,7 @@ pub fn load_mesh(path: &Path) -> Result<MeshData, MeshError> {
     match triangles.len() {
         0 => Err(MeshError::Empty { path: path.to_owned() }),
         count if count > limits::MESH_TRIANGLES => Err(MeshError::TooMany { path: path.to_owned(), count }),
-        _ => Ok(MeshData { triangles }),
+        _ => Ok(MeshData::new(triangles)),
     }
 }
 

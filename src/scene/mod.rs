@@ -309,10 +309,13 @@ impl Scene {
         validate::validate(self)
     }
 
-    /// A stable 64-bit key of the scene's content (FNV-1a of its RON form),
-    /// used to tie saved photon maps and references to the scene they belong to.
+    /// A stable 64-bit key of the scene's content (FNV-1a of its RON form,
+    /// then of each mesh's own key: a mesh file changed under the same name
+    /// is another scene), used to tie saved photon maps and references to
+    /// the scene they belong to.
     pub fn content_key(&self) -> u64 {
         let text = to_ron(self).unwrap_or_default();
-        text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
+        let meshes = self.meshes.keys().flat_map(u64::to_le_bytes);
+        (text.bytes().chain(meshes)).fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
     }
 }
