@@ -1,7 +1,9 @@
-//! Engine speed: ray–sphere intersections per second, shadow rays one and
+//! Engine speed: ray–sphere intersections per second, nearest hits on a
+//! quarter-million-triangle mesh, shadow rays one and
 //! eight at a time, and path-traced samples per second on every preset at
 //! 512×384 (run with `cargo bench`).
 
+use std::f32::consts::PI;
 use std::hint::black_box;
 use std::sync::Arc;
 
@@ -27,6 +29,57 @@ fn ray_sphere(c: &mut Criterion) {
             }
             hits
         })
+    });
+    group.finish();
+}
+
+/// The blob `benches/embree_mesh.py` gives Embree: a sphere of `rings` ×
+/// 2·`rings` quads, its radius rippled, as triangles.
+fn blob(rings: u32) -> Vec<[Vec3; 3]> {
+    let at = |i: u32, j: u32| {
+        let (theta, phi) = (PI * i as f32 / rings as f32, PI * j as f32 / rings as f32);
+        let r = 1.0 + 0.1 * (7.0 * theta).sin() * (5.0 * phi).cos();
+        Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()) * r
+    };
+    let mut triangles = Vec::new();
+    for i in 0..rings {
+        for j in 0..2 * rings {
+            let [a, b, c, d] = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+            triangles.extend([[a, c, b], [a, d, c]]);
+        }
+    }
+    triangles
+}
+
+/// Nearest hits of rays from a sphere of radius 3 aimed into a ball of
+/// radius 0.9 about a mesh of a quarter of a million triangles, one
+/// thread, through the world's hierarchy: against Embree's, same mesh and
+/// rays, by `benches/embree_mesh.py`.
+fn mesh_rays(c: &mut Criterion) {
+    use gi_studio::render::world::World;
+    use gi_studio::scene::mesh::MeshData;
+    use gi_studio::scene::{Object, Shape, ValidScene};
+    let mut scene = presets::preset("thesis").unwrap().unwrap().into_scene();
+    scene.objects = vec![Object {
+        name: "blob".into(),
+        shape: Shape::Mesh { file: "blob".into(), translate: Vec3::ZERO, scale: 1.0, rotate_degrees: Vec3::ZERO },
+        material: scene.materials[0].name.clone(),
+    }];
+    scene.meshes.insert("blob".into(), Arc::new(MeshData::new(blob(256))));
+    let world = World::new(&ValidScene::new(scene).expect("the blob's scene"));
+    let mut s = Sampler::new(0, 0, 3);
+    let rays: Vec<Ray> = (0..100_000)
+        .map(|_| {
+            let origin = uniform_sphere(s.next_2d()) * 3.0;
+            let target = uniform_sphere(s.next_2d()) * 0.9 * s.next_f32().cbrt();
+            Ray::new(origin, (target - origin).normalize())
+        })
+        .collect();
+    let mut group = c.benchmark_group("geometry");
+    group.throughput(Throughput::Elements(rays.len() as u64));
+    group.sample_size(20);
+    group.bench_function("mesh_262k_triangles_nearest_hits", |b| {
+        b.iter(|| rays.iter().filter(|ray| world.intersect(black_box(ray), f32::INFINITY).is_some()).count())
     });
     group.finish();
 }
@@ -162,5 +215,5 @@ fn shadow_rays(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, ray_sphere, shadow_rays, path_presets, whitted_cornell, sppm_caustics);
+criterion_group!(benches, ray_sphere, mesh_rays, shadow_rays, path_presets, whitted_cornell, sppm_caustics);
 criterion_main!(benches);

@@ -10,7 +10,7 @@
 //! every primitive in the order the traversal meets them finds, each
 //! against the nearest hit so far.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 use crate::geometry::{gamma, Ray};
 
@@ -20,8 +20,12 @@ const LEAF: usize = 4;
 /// Bins the centroids are counted into along the split axis.
 const BINS: usize = 12;
 
-/// How deep the traversal's stack goes: the build splits no deeper.
-const MAX_DEPTH: usize = 64;
+/// How deep the build splits.
+const MAX_DEPTH: usize = 48;
+
+/// The traversal's stack: a four-wide node is at least one binary level
+/// below its parent, and each leaves at most three children waiting.
+const STACK: usize = 3 * MAX_DEPTH + 1;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
@@ -33,10 +37,36 @@ struct Node {
     count: u32,
 }
 
+/// Four children's boxes side by side, tested against a ray at once.
+#[derive(Clone, Copy, Debug)]
+struct Wide {
+    /// Per axis, each child's low and high bound.
+    lo: [Vec4; 3],
+    hi: [Vec4; 3],
+    /// Per child: an inner node's index in `wide`, or a leaf's first
+    /// primitive in `order`.
+    start: [u32; 4],
+    /// Per child: a leaf's count of primitives; 0 for an inner node.
+    count: [u32; 4],
+    /// The children it has, a bit each.
+    valid: u32,
+}
+
+impl Wide {
+    const EMPTY: Wide = Wide { lo: [Vec4::ZERO; 3], hi: [Vec4::ZERO; 3], start: [0; 4], count: [0; 4], valid: 0 };
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    nodes: Vec<Node>,
+    /// The binary tree as built, four-wide (`widen`): what rays traverse.
+    wide: Vec<Wide>,
     /// Primitive indices, each leaf's a run of them.
+    order: Vec<u32>,
+}
+
+/// The binary tree as the build makes it.
+struct Binary {
+    nodes: Vec<Node>,
     order: Vec<u32>,
 }
 
@@ -58,8 +88,11 @@ fn half_area((lo, hi): Bounds) -> f32 {
 impl Bvh {
     /// Over primitives with boxes `bounds` (index i for `bounds[i]`).
     pub fn new(bounds: &[Bounds]) -> Self {
+        if bounds.is_empty() {
+            return Bvh::default();
+        }
         let centroids: Vec<Vec3> = bounds.iter().map(|(lo, hi)| (*lo + *hi) * 0.5).collect();
-        let mut bvh = Bvh { nodes: Vec::with_capacity(2 * bounds.len()), order: (0..bounds.len() as u32).collect() };
+        let mut bvh = Binary { nodes: Vec::with_capacity(2 * bounds.len()), order: (0..bounds.len() as u32).collect() };
         bvh.nodes.push(Node { lo: Vec3::ZERO, hi: Vec3::ZERO, start: 0, count: 0 });
         // (node, first, end, depth): ranges of `order` still to place
         let mut todo = vec![(0usize, 0usize, bounds.len(), 0usize)];
@@ -84,7 +117,7 @@ impl Bvh {
             todo.push((left, first, first + middle, depth + 1));
             todo.push((left + 1, first + middle, end, depth + 1));
         }
-        bvh
+        Bvh { wide: Self::widen(&bvh.nodes), order: bvh.order }
     }
 
     /// Sorts `range` about the cheapest split by the heuristic and says
@@ -146,21 +179,36 @@ impl Bvh {
         self.order.is_empty()
     }
 
-    /// The ray's entry into `node`'s box if it meets it before `t_max`
-    /// (the exit pushed out by the slab test's rounding, so no hit in the
-    /// box is missed).
+    /// The ray as the box tests take it: its origin and the inverse of its
+    /// direction in every lane, a zero component's inverse huge but finite
+    /// (an infinite one times a zero distance would be NaN).
     #[inline(always)]
-    fn enter(node: &Node, origin: Vec3, inverse: Vec3, t_max: f32) -> Option<f32> {
-        let t0 = (node.lo - origin) * inverse;
-        let t1 = (node.hi - origin) * inverse;
-        let near = t0.min(t1).max_element().max(0.0);
-        let far = t0.max(t1).min_element() * (1.0 + 2.0 * gamma(3));
-        (near <= far && near < t_max).then_some(near)
+    fn lanes_of(ray: &Ray) -> ([Vec4; 3], [Vec4; 3]) {
+        let inverse = |d: f32| if d == 0.0 { f32::MAX.copysign(d) } else { 1.0 / d };
+        let o = ray.origin;
+        let d = ray.direction;
+        ([o.x, o.y, o.z].map(Vec4::splat), [inverse(d.x), inverse(d.y), inverse(d.z)].map(Vec4::splat))
+    }
+
+    /// Which of `node`'s children the ray meets before `t_max` (a bit a
+    /// child), and where it enters each (the exits pushed out by the slab
+    /// test's rounding, so no hit in a box is missed).
+    #[inline(always)]
+    fn enter(node: &Wide, (origin, inverse): &([Vec4; 3], [Vec4; 3]), t_max: f32) -> (u32, Vec4) {
+        // Written out: `map`'s closures may be left out of line
+        let (x0, x1) = ((node.lo[0] - origin[0]) * inverse[0], (node.hi[0] - origin[0]) * inverse[0]);
+        let (y0, y1) = ((node.lo[1] - origin[1]) * inverse[1], (node.hi[1] - origin[1]) * inverse[1]);
+        let (z0, z1) = ((node.lo[2] - origin[2]) * inverse[2], (node.hi[2] - origin[2]) * inverse[2]);
+        let near = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(Vec4::ZERO);
+        let far = x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + 2.0 * gamma(3));
+        let met = near.cmple(far) & near.cmplt(Vec4::splat(t_max));
+        (met.bitmask() & node.valid, near)
     }
 
     /// The nearest hit within (0, t_max) of `test` (given a primitive and
     /// the nearest hit so far, its hit nearer than that, with its t), and
-    /// the primitive's index.
+    /// the primitive's index. Children are visited nearest first, and none
+    /// the ray enters beyond the nearest hit so far.
     #[inline]
     pub fn nearest<H>(
         &self,
@@ -171,58 +219,45 @@ impl Bvh {
         if self.order.is_empty() {
             return None;
         }
-        let (origin, inverse) = (ray.origin, ray.direction.recip());
+        let lanes = Self::lanes_of(ray);
         let mut best_t = t_max;
         let mut found = None;
-        let mut stack = [0u32; MAX_DEPTH];
-        let mut depth = 0;
-        let mut node = 0usize;
-        // A ray that misses the whole box tests nothing
-        Self::enter(&self.nodes[0], origin, inverse, best_t)?;
-        loop {
-            let n = &self.nodes[node];
-            if n.count > 0 {
-                for &i in &self.order[n.start as usize..(n.start + n.count) as usize] {
+        // (start, count, entry): a wide node (count 0) or a leaf's primitives
+        let mut stack = [(0u32, 0u32, 0.0f32); STACK];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let (start, count, entry) = stack[depth];
+            if entry >= best_t {
+                continue;
+            }
+            if count > 0 {
+                for &i in &self.order[start as usize..(start + count) as usize] {
                     if let Some((t, hit)) = test(i, best_t) {
                         best_t = t;
                         found = Some((i, hit));
                     }
                 }
-            } else {
-                let (left, right) = (n.start as usize, n.start as usize + 1);
-                let near_left = Self::enter(&self.nodes[left], origin, inverse, best_t);
-                let near_right = Self::enter(&self.nodes[right], origin, inverse, best_t);
-                match (near_left, near_right) {
-                    (Some(l), Some(r)) => {
-                        let (first, second) = if l <= r { (left, right) } else { (right, left) };
-                        stack[depth] = second as u32;
-                        depth += 1;
-                        node = first;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        node = left;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        node = right;
-                        continue;
-                    }
-                    (None, None) => {}
-                }
+                continue;
             }
-            // Next on the stack, if the ray still meets it before its nearest hit
-            loop {
-                if depth == 0 {
-                    return found;
+            let node = &self.wide[start as usize];
+            let (mut met, near) = Self::enter(node, &lanes, best_t);
+            let near = near.to_array();
+            // Farthest first onto the stack, so the nearest comes off first
+            let first = depth;
+            while met != 0 {
+                let k = met.trailing_zeros() as usize;
+                met &= met - 1;
+                let mut at = depth;
+                while at > first && stack[at - 1].2 < near[k] {
+                    stack[at] = stack[at - 1];
+                    at -= 1;
                 }
-                depth -= 1;
-                node = stack[depth] as usize;
-                if Self::enter(&self.nodes[node], origin, inverse, best_t).is_some() {
-                    break;
-                }
+                stack[at] = (node.start[k], node.count[k], near[k]);
+                depth += 1;
             }
         }
+        found
     }
 
     /// Whether `test` (given a primitive) holds for any primitive whose box
@@ -232,27 +267,69 @@ impl Bvh {
         if self.order.is_empty() {
             return false;
         }
-        let (origin, inverse) = (ray.origin, ray.direction.recip());
-        // Both children go on it: one more than the tree is deep
-        let mut stack = [0u32; MAX_DEPTH + 1];
+        let lanes = Self::lanes_of(ray);
+        let mut stack = [(0u32, 0u32); STACK];
         let mut depth = 1;
         while depth > 0 {
             depth -= 1;
-            let n = &self.nodes[stack[depth] as usize];
-            if Self::enter(n, origin, inverse, t_max).is_none() {
-                continue;
-            }
-            if n.count > 0 {
-                if self.order[n.start as usize..(n.start + n.count) as usize].iter().any(|&i| test(i)) {
+            let (start, count) = stack[depth];
+            if count > 0 {
+                if self.order[start as usize..(start + count) as usize].iter().any(|&i| test(i)) {
                     return true;
                 }
-            } else {
-                stack[depth] = n.start;
-                stack[depth + 1] = n.start + 1;
-                depth += 2;
+                continue;
+            }
+            let node = &self.wide[start as usize];
+            let (mut met, _) = Self::enter(node, &lanes, t_max);
+            while met != 0 {
+                let k = met.trailing_zeros() as usize;
+                met &= met - 1;
+                stack[depth] = (node.start[k], node.count[k]);
+                depth += 1;
             }
         }
         false
+    }
+
+    /// The binary tree `nodes` as four-wide nodes: each takes its node's
+    /// children, then opens the largest of those that are inner nodes until
+    /// it holds four.
+    fn widen(nodes: &[Node]) -> Vec<Wide> {
+        let mut wide = vec![Wide::EMPTY];
+        let mut todo = vec![(0usize, 0usize)];
+        while let Some((binary, at)) = todo.pop() {
+            let node = &nodes[binary];
+            let mut children = match node.count {
+                0 => vec![node.start as usize, node.start as usize + 1],
+                _ => vec![binary],
+            };
+            while children.len() < 4 {
+                let area = |&(_, &n): &(usize, &usize)| half_area((nodes[n].lo, nodes[n].hi));
+                let inner = children.iter().enumerate().filter(|(_, &n)| nodes[n].count == 0);
+                let Some((k, _)) = inner.max_by(|a, b| area(a).total_cmp(&area(b))) else { break };
+                let opened = children.swap_remove(k);
+                children.extend([nodes[opened].start as usize, nodes[opened].start as usize + 1]);
+            }
+            let mut filled = Wide::EMPTY;
+            for (k, &n) in children.iter().enumerate() {
+                let child = &nodes[n];
+                for axis in 0..3 {
+                    filled.lo[axis][k] = child.lo[axis];
+                    filled.hi[axis][k] = child.hi[axis];
+                }
+                filled.valid |= 1 << k;
+                (filled.start[k], filled.count[k]) = match child.count {
+                    0 => {
+                        todo.push((n, wide.len()));
+                        wide.push(Wide::EMPTY);
+                        (wide.len() as u32 - 1, 0)
+                    }
+                    count => (child.start, count),
+                };
+            }
+            wide[at] = filled;
+        }
+        wide
     }
 }
 
@@ -352,6 +429,6 @@ mod tests {
         }
         let mean = tested as f32 / rays as f32;
         assert!(mean < 0.02 * list.len() as f32, "{mean} triangles tested a ray, of {}", list.len());
-        assert!(bvh.nodes.len() < 2 * list.len());
+        assert!(bvh.wide.len() < list.len());
     }
 }
