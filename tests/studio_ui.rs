@@ -446,9 +446,12 @@ fn clicking_a_sphere_in_the_viewport_selects_it() {
 fn every_menu_opens_and_draws() {
     let mut harness = studio(1);
     harness.run_steps(2);
-    for (menu, entry) in
-        [("File", "Open…"), ("Edit", "Undo"), ("View", "Plots"), ("Help", "Drop a .ron file on the window to open it.")]
-    {
+    for (menu, entry) in [
+        ("File", "Open…"),
+        ("Edit", "Undo"),
+        ("View", "Plots"),
+        ("Help", "Drop a .ron file on the window to open it, an .obj or .ply to import it."),
+    ] {
         harness.get_by_label(menu).click();
         harness.run_steps(2);
         harness.get_by_label_contains(entry);
@@ -1008,4 +1011,76 @@ fn a_light_handle_selects_and_moves_its_light() {
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     harness.run_steps(2);
     assert_eq!(*harness.state().scene(), before, "one undo takes back the drag");
+}
+
+/// A file dropped on the window, as the windowing layer hands it over.
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &std::path::Path {
+        &self.0
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+/// A cube as a Wavefront OBJ (six quads).
+fn cube_obj() -> String {
+    let corners = ["0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1"];
+    let faces = ["1 4 3 2", "5 6 7 8", "1 2 6 5", "3 4 8 7", "2 3 7 6", "1 5 8 4"];
+    corners.iter().map(|c| format!("v {c}\n")).chain(faces.iter().map(|f| format!("f {f}\n"))).collect()
+}
+
+/// A dropped OBJ becomes an object in view, selected, that the panes
+/// render (the image changes) and one undo removes; a broken one is
+/// refused with its reason and changes nothing. File ▸ Import mesh… reads
+/// one through the dialog.
+#[test]
+fn a_dropped_or_imported_mesh_joins_the_scene_in_view() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-ui-mesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (cube, broken) = (dir.join("cube.obj"), dir.join("broken.ply"));
+    std::fs::write(&cube, cube_obj()).unwrap();
+    std::fs::write(&broken, "ply\nformat ascii 1.0\nelement vertex 900000000\nend_header\n").unwrap();
+    let mut harness = studio(1);
+    step_until(&mut harness, |app| app.panes().list()[0].state().finished);
+    let (before, image) =
+        (harness.state().scene().clone(), harness.state().panes().list()[0].state().image.pixels.clone());
+    let drop = |harness: &mut Harness<'static, StudioApp>, path: &std::path::Path| {
+        harness.input_mut().dropped_files.push(std::sync::Arc::new(Dropped(path.to_owned())));
+        harness.run_steps(2);
+    };
+    drop(&mut harness, &broken);
+    assert_eq!(*harness.state().scene(), before);
+    let error = harness.state().messages().error.clone().expect("an error is shown");
+    assert!(error.contains("broken.ply") && error.contains("more than the file holds"), "{error}");
+
+    drop(&mut harness, &cube);
+    let objects = &harness.state().scene().objects;
+    let added = objects.last().expect("an object");
+    assert_eq!((objects.len(), added.name.as_str()), (before.objects.len() + 1, "cube"));
+    assert_eq!(harness.state().selection(), Selection::Object(objects.len() - 1));
+    let Shape::Mesh { translate, .. } = added.shape else { panic!("not a mesh: {:?}", added.shape) };
+    let camera = CameraModel::new(&before.camera, 64, 48);
+    let at = camera.project(translate).expect("the cube in front of the camera");
+    let (x, y) = (at.x, at.y);
+    assert!((0.0..64.0).contains(&x) && (0.0..48.0).contains(&y), "the cube at ({x}, {y}), out of view");
+    step_until(&mut harness, |app| {
+        app.panes().list()[0].state().finished && app.scene().objects.len() > before.objects.len()
+    });
+    assert_ne!(harness.state().panes().list()[0].state().image.pixels, image, "the cube is not rendered");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(harness.state().scene().objects, before.objects);
+
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness.get_by_label("Import mesh…").click();
+    harness.run_steps(4);
+    harness.get_by_label("Import mesh (OBJ, PLY)");
+    answer_file_dialog(&mut harness, &cube, "Import");
+    assert!(matches!(harness.state().scene().objects.last().map(|o| &o.shape), Some(Shape::Mesh { .. })));
 }

@@ -28,6 +28,8 @@ pub enum Command {
     /// A path the file dialog chose (and, if it existed, the user agreed
     /// to replace), for what the dialog was for.
     Write(DialogPurpose, PathBuf),
+    /// Add a mesh file's triangles to the scene as an object.
+    ImportMesh(PathBuf),
     Undo,
     Redo,
     SetPanes(usize),

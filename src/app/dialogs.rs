@@ -43,6 +43,7 @@ impl Dialogs {
                 let extension = if exr { "exr" } else { "png" };
                 in_folder(&format!("pane{}-{}.{extension}", pane + 1, algorithm.name()))
             }
+            DialogPurpose::ImportMesh => in_folder(""),
             DialogPurpose::Screenshot => in_folder("screenshot.png"),
             DialogPurpose::ComparisonSheet => in_folder("comparison.png"),
         };
@@ -81,7 +82,8 @@ impl Dialogs {
                 }
                 // Writing over another file is the user's call, asked once
                 let own_file = purpose == DialogPurpose::SaveScene && scene_path == Some(path.as_path());
-                if purpose != DialogPurpose::OpenScene && path.exists() && !own_file {
+                let reads = matches!(purpose, DialogPurpose::OpenScene | DialogPurpose::ImportMesh);
+                if !reads && path.exists() && !own_file {
                     self.replace = Some((purpose, path));
                 } else {
                     commands.push(Command::Write(purpose, path));

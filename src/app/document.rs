@@ -10,8 +10,15 @@ use std::sync::Arc;
 use super::history::History;
 use crate::render::world::camera::CameraModel;
 use crate::render::world::World;
+use crate::scene::mesh::{load_mesh, MeshError};
 use crate::scene::presets::default_scene;
-use crate::scene::{load_scene, save_scene, to_ron, Invalid, Scene, SceneFileError, ValidScene};
+use crate::scene::{load_scene, save_scene, to_ron, Invalid, Object, Scene, SceneFileError, Shape, ValidScene};
+use glam::Vec3;
+
+/// `base`, or `base 2`, `base 3`, … : the first that `taken` does not hold.
+pub fn unique_name(base: &str, taken: impl Fn(&str) -> bool) -> String {
+    (1..).map(|n| if n == 1 { base.to_owned() } else { format!("{base} {n}") }).find(|n| !taken(n)).unwrap_or_default()
+}
 
 /// A place in view to put a new object.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -87,6 +94,31 @@ impl Document {
     pub fn changed(&mut self) {
         self.revision = self.next_revision;
         self.next_revision += 1;
+    }
+
+    /// Add the mesh in `path` as an object, in view: on the surface at the
+    /// centre of the view, a quarter of its distance across. The scene is
+    /// untouched if the file does not read. Returns the object's index.
+    pub fn import_mesh(&mut self, path: &Path) -> Result<usize, MeshError> {
+        let mesh = load_mesh(path)?;
+        // Its own full path: the scene finds it wherever the scene is saved
+        let file = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()).display().to_string();
+        let (lo, hi) = (mesh.triangles.iter().flatten())
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+        let spot = self.spot_in_view();
+        let scale = spot.distance * 0.25 / (hi - lo).max_element().max(1e-6);
+        // Its box's centre half its height above the surface
+        let centre = (lo + hi) * 0.5;
+        let translate = spot.point + spot.normal * ((hi - lo).max_element() * 0.5 * scale) - centre * scale;
+        let stem = path.file_stem().map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
+        let scene = &mut self.scene;
+        let name = unique_name(&stem, |n| scene.objects.iter().any(|o| o.name == n));
+        let material = scene.materials.first().map(|m| m.name.clone()).unwrap_or_default();
+        scene.meshes.insert(file.clone(), Arc::new(mesh));
+        let shape = Shape::Mesh { file, translate, scale, rotate_degrees: Vec3::ZERO };
+        scene.objects.push(Object { name, shape, material });
+        self.changed();
+        Ok(self.scene.objects.len() - 1)
     }
 
     pub fn path(&self) -> Option<&Path> {

@@ -11,6 +11,8 @@ use crate::render::Algorithm;
 pub enum DialogPurpose {
     OpenScene,
     SaveScene,
+    /// A mesh file (OBJ or PLY) to add to the scene.
+    ImportMesh,
     /// Pane `pane`'s image, made by `algorithm`, as PNG (display) or EXR (linear).
     ExportImage {
         pane: usize,
@@ -26,6 +28,7 @@ impl DialogPurpose {
         match self {
             DialogPurpose::OpenScene => "Open scene".into(),
             DialogPurpose::SaveScene => "Save scene as".into(),
+            DialogPurpose::ImportMesh => "Import mesh (OBJ, PLY)".into(),
             DialogPurpose::ExportImage { pane, algorithm, exr } => {
                 let format = if exr { "EXR, linear" } else { "PNG" };
                 format!("Export pane {}'s image ({}) as {format}", pane + 1, algorithm.label())
@@ -90,7 +93,11 @@ pub fn file_dialog_ui(ctx: &egui::Context, dialog: &mut FileDialog) -> (Option<P
             });
         }
         ui.horizontal(|ui| {
-            let verb = if dialog.purpose == DialogPurpose::OpenScene { "Open" } else { "Save" };
+            let verb = match dialog.purpose {
+                DialogPurpose::OpenScene => "Open",
+                DialogPurpose::ImportMesh => "Import",
+                _ => "Save",
+            };
             if ui.button(verb).clicked() {
                 chosen = Some(PathBuf::from(&dialog.path));
             }

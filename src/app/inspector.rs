@@ -6,7 +6,7 @@
 use eframe::egui;
 use glam::Vec3;
 
-use super::document::Spot;
+use super::document::{unique_name, Spot};
 use super::widgets::{committed_text_ui, number, slider};
 
 use crate::scene::{Attenuation, ClipAlong, Invalid, Light, LightKind, Material, MaterialModel, Object, Scene, Shape};
@@ -57,10 +57,6 @@ fn selected_title(scene: &Scene, selection: Selection) -> String {
         Selection::Material(i) => scene.materials.get(i).map_or("—".into(), |m| format!("Material “{}”", m.name)),
         Selection::Light(i) => scene.lights.get(i).map_or("—".into(), |l| format!("Light “{}”", l.name)),
     }
-}
-
-fn unique_name(base: &str, taken: impl Fn(&str) -> bool) -> String {
-    (1..).map(|n| if n == 1 { base.to_owned() } else { format!("{base} {n}") }).find(|n| !taken(n)).unwrap_or_default()
 }
 
 /// The lists with their add, duplicate and delete buttons.

@@ -24,8 +24,13 @@ pub fn input_commands(ctx: &egui::Context, commands: &mut Vec<Command>) -> Windo
         commands.push(Command::OpenDialog(DialogPurpose::OpenScene));
     }
     let dropped: Vec<PathBuf> = ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_owned()).collect());
-    if let Some(path) = dropped.into_iter().find(|p| p.extension().is_some_and(|e| e == "ron")) {
-        commands.push(Command::Request(Action::Open(path)));
+    let extension = |p: &PathBuf| p.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    for path in dropped {
+        match extension(&path).as_deref() {
+            Some("obj" | "ply") => commands.push(Command::ImportMesh(path)),
+            Some("ron") => commands.push(Command::Request(Action::Open(path))),
+            _ => {}
+        }
     }
     WindowState {
         close_requested: ctx.input(|i| i.viewport().close_requested()),

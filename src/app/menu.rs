@@ -59,7 +59,7 @@ pub fn menu_bar_ui(ui: &mut egui::Ui, view: &MenuView, commands: &mut Vec<Comman
             ui.label("Drag: orbit · Shift+drag: pan · Scroll: dolly · Click: select");
             ui.label("Ctrl+scroll: zoom the images · Ctrl+drag: pan them · F: whole images");
             ui.label("Ctrl+Z / Ctrl+Shift+Z: undo / redo · Ctrl+S: save · Ctrl+O: open");
-            ui.label("Drop a .ron file on the window to open it.");
+            ui.label("Drop a .ron file on the window to open it, an .obj or .ply to import it.");
             ui.separator();
             let algorithms: Vec<&str> = Algorithm::ALL.iter().map(|a| a.label()).collect();
             ui.label(format!("GI Studio {}", env!("CARGO_PKG_VERSION")));
@@ -86,6 +86,9 @@ fn file_menu_ui(ui: &mut egui::Ui, view: &MenuView, commands: &mut Vec<Command>)
     });
     if ui.button("Open…").clicked() {
         choose(ui, Command::OpenDialog(DialogPurpose::OpenScene));
+    }
+    if ui.button("Import mesh…").clicked() {
+        choose(ui, Command::OpenDialog(DialogPurpose::ImportMesh));
     }
     ui.menu_button("Open recent", |ui| {
         if view.recent.is_empty() {

@@ -117,6 +117,13 @@ impl StudioApp {
                 }
             }
             Command::Write(purpose, path) => self.write_chosen(purpose, path),
+            Command::ImportMesh(path) => match self.document.import_mesh(&path) {
+                Ok(object) => {
+                    self.selection = Selection::Object(object);
+                    self.messages.say(format!("Imported {}", path.display()));
+                }
+                Err(e) => self.messages.fail(e),
+            },
             Command::Undo => self.document.undo(),
             Command::Redo => self.document.redo(),
             Command::SetPanes(count) if count != self.panes.count() => {
@@ -184,6 +191,7 @@ impl StudioApp {
         match purpose {
             DialogPurpose::OpenScene => self.apply(Command::Request(Action::Open(path))),
             DialogPurpose::SaveScene => self.save_to(&path),
+            DialogPurpose::ImportMesh => self.apply(Command::ImportMesh(path)),
             DialogPurpose::ExportImage { pane, .. } => self.export_pane(pane, &path),
             DialogPurpose::Screenshot => self.take_screenshot(path, None),
             DialogPurpose::ComparisonSheet => self.take_screenshot(path, Some(self.panes.area())),
