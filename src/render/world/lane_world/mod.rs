@@ -234,7 +234,11 @@ impl LaneWorld {
             plane_offsets: Column::new(by_shape().map(|p| p.map_or(0.0, |p| p.offset))),
             planes,
             triangles: world.shapes.triangles.iter().map(|(triangle, _)| *triangle).collect(),
-            triangle_culls: lane_culls(&world.shapes.triangles),
+            // A hierarchy's triangles are never culled in the lanes
+            triangle_culls: match world.shapes.triangle_bvh {
+                Some(_) => Vec::new(),
+                None => lane_culls(&world.shapes.triangles),
+            },
             triangle_bvh: world.shapes.triangle_bvh.clone(),
             triangle_planes: world.light_plane.clone(),
             surfaces,
