@@ -1084,3 +1084,25 @@ fn a_dropped_or_imported_mesh_joins_the_scene_in_view() {
     answer_file_dialog(&mut harness, &cube, "Import");
     assert!(matches!(harness.state().scene().objects.last().map(|o| &o.shape), Some(Shape::Mesh { .. })));
 }
+
+/// A scene of many objects lists only the rows in view (a list of 100,000
+/// took seconds a frame to lay out), and scrolls to the rest.
+#[test]
+fn a_long_object_list_lays_out_only_the_rows_in_view() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gi-ui-many-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut scene = gi_studio::scene::presets::preset("cornell").unwrap().unwrap().into_scene();
+    for k in 0..2000 {
+        let center = glam::Vec3::new(-0.9 + 0.0009 * k as f32, 0.02, -0.9);
+        let shape = Shape::Sphere { center, radius: 0.0004 };
+        scene.objects.push(gi_studio::scene::Object { name: format!("speck {k}"), shape, material: "white".into() });
+    }
+    let path = dir.join("many.ron");
+    std::fs::write(&path, gi_studio::scene::to_ron(&scene).unwrap()).unwrap();
+    let mut harness = studio(1);
+    harness.state_mut().open_path(&path);
+    harness.run_steps(3);
+    assert_eq!(harness.state().scene().objects.len(), scene.objects.len());
+    harness.get_by_label("speck 0 (sphere)");
+    assert!(harness.query_by_label("speck 1999 (sphere)").is_none(), "every row laid out");
+}

@@ -59,16 +59,34 @@ fn selected_title(scene: &Scene, selection: Selection) -> String {
     }
 }
 
+/// Up to how many objects the list shows whole; a longer one scrolls in a
+/// box of its own, drawing only the rows in view.
+const LISTED_OBJECTS: usize = 64;
+
 /// The lists with their add, duplicate and delete buttons.
 fn list_ui(ui: &mut egui::Ui, scene: &mut Scene, selection: &mut Selection, spot: Spot) -> bool {
     let before = (scene.objects.len(), scene.materials.len(), scene.lights.len());
     let mut toggled = false;
     egui::CollapsingHeader::new("Objects").default_open(true).show(ui, |ui| {
-        for (i, object) in scene.objects.iter().enumerate() {
+        let row = |ui: &mut egui::Ui, i: usize, selection: &mut Selection| {
+            let object = &scene.objects[i];
             ui.selectable_value(
                 selection,
                 Selection::Object(i),
                 format!("{} ({})", object.name, shape_name(&object.shape)),
+            );
+        };
+        if scene.objects.len() <= LISTED_OBJECTS {
+            (0..scene.objects.len()).for_each(|i| row(ui, i, selection));
+        } else {
+            // Only the rows in view are laid out: a scene of 100,000 balls
+            // took seconds a frame to list them all
+            let height = ui.spacing().interact_size.y;
+            egui::ScrollArea::vertical().id_salt("objects").max_height(height * 16.0).show_rows(
+                ui,
+                height,
+                scene.objects.len(),
+                |ui, rows| rows.for_each(|i| row(ui, i, selection)),
             );
         }
         ui.horizontal(|ui| {
