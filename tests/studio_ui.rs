@@ -51,6 +51,21 @@ fn step_frames_until(harness: &mut Harness<'static, StudioApp>, frames: usize, d
     panic!("condition not reached");
 }
 
+/// A mouse drag from `start` by `by`, in `steps` moves a frame apart, as a
+/// hand makes it (press, moves, release).
+fn drag(harness: &mut Harness<'static, StudioApp>, start: egui::Pos2, by: egui::Vec2, steps: u32) {
+    harness.hover_at(start);
+    harness.run_steps(1);
+    harness.drag_at(start);
+    harness.run_steps(1);
+    for step in 1..=steps {
+        harness.hover_at(start + by * (step as f32 / steps as f32));
+        harness.run_steps(1);
+    }
+    harness.drop_at(start + by);
+    harness.run_steps(2);
+}
+
 fn radius_of(app: &StudioApp, name: &str) -> f32 {
     match app.scene().objects.iter().find(|o| o.name == name).map(|o| &o.shape) {
         Some(Shape::Sphere { radius, .. }) => *radius,
@@ -396,16 +411,7 @@ fn an_orbit_drag_turns_with_the_view() {
     harness.run_steps(2);
     let rect = harness.state().panes().rects()[0];
     let start = rect.center();
-    harness.hover_at(start);
-    harness.run_steps(1);
-    harness.drag_at(start);
-    harness.run_steps(1);
-    for step in 1..=8 {
-        harness.hover_at(start + egui::vec2(10.0 * step as f32, 0.0));
-        harness.run_steps(1);
-    }
-    harness.drop_at(start + egui::vec2(80.0, 0.0));
-    harness.run_steps(2);
+    drag(&mut harness, start, egui::vec2(80.0, 0.0), 8);
     let camera = &harness.state().scene().camera;
     let turned = (camera.position - camera.look_at).angle_between(glam::Vec3::new(0.0, 0.0, 3.4)).to_degrees();
     let expected = 40.0 * 80.0 / rect.height();
@@ -884,17 +890,8 @@ fn a_wipe_divider_follows_the_drag_and_not_the_camera() {
     assert!(harness.query_by_label("wipe pane 1 | pane 2").is_some(), "no divider drawn");
     let rect = harness.state().panes().rects()[0];
     let start = rect.center();
-    harness.hover_at(start);
-    harness.run_steps(1);
-    harness.drag_at(start);
-    harness.run_steps(1);
     let dx = -rect.width() / 4.0;
-    for step in 1..=5 {
-        harness.hover_at(start + egui::vec2(dx * step as f32 / 5.0, 0.0));
-        harness.run_steps(1);
-    }
-    harness.drop_at(start + egui::vec2(dx, 0.0));
-    harness.run_steps(2);
+    drag(&mut harness, start, egui::vec2(dx, 0.0), 5);
     let divider = harness.state().panes().wipe(0).expect("still on").divider;
     assert!((divider - 0.25).abs() < 0.01, "the divider stands at {divider}, not 0.25");
     assert_eq!(*harness.state().scene(), original, "dragging the divider moved the camera");
@@ -990,16 +987,7 @@ fn a_light_handle_selects_and_moves_its_light() {
     assert_eq!(harness.state().selection(), Selection::Light(index));
     let before = harness.state().scene().clone();
     let at = harness.get_all_by_label("light bulb").next().expect("a handle").rect().center();
-    harness.hover_at(at);
-    harness.run_steps(1);
-    harness.drag_at(at);
-    harness.run_steps(1);
-    for step in 1..=4 {
-        harness.hover_at(at + egui::vec2(5.0 * step as f32, 0.0));
-        harness.run_steps(1);
-    }
-    harness.drop_at(at + egui::vec2(20.0, 0.0));
-    harness.run_steps(2);
+    drag(&mut harness, at, egui::vec2(20.0, 0.0), 4);
     let position = |scene: &gi_studio::scene::Scene| match scene.lights[index].kind {
         gi_studio::scene::LightKind::Point { position } => position,
         _ => panic!("not a point light"),
