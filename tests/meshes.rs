@@ -128,7 +128,8 @@ fn cube_scenes(dir: &Path, file: &str) -> (std::path::PathBuf, ValidScene) {
     };
     let mut typed = scene.clone();
     for (k, [a, b, c]) in cube_triangles().into_iter().enumerate() {
-        let (a, b, c) = (shape.place(a), shape.place(b), shape.place(c));
+        let placement = shape.placement();
+        let [a, b, c] = [a, b, c].map(|v| placement.transform_point3(v));
         let name = format!("cube {k}");
         typed.objects.push(Object { name, shape: Shape::Triangle { a, b, c }, material: "white".into() });
     }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use super::mesh::{load_mesh, MeshError, Meshes};
-use super::{Invalid, Problem, Scene, Shape, ValidScene};
+use super::{Invalid, Scene, Shape, ValidScene};
 use crate::fileio::{self, FileError};
 use crate::limits;
 
@@ -64,7 +64,7 @@ pub fn parse_scene_with(text: &str, path: &Path, loaded: &Meshes) -> Result<Vali
     };
     let others = problems.len() - 1;
     let invalid = problems.swap_remove(0);
-    let (line, column) = locate(text, &invalid);
+    let (line, column) = locate(text, invalid.section, invalid.index, invalid.key);
     Err(SceneFileError::Invalid { path: path.to_owned(), line, column, invalid: Box::new(invalid), others })
 }
 
@@ -88,15 +88,7 @@ fn load_meshes(scene: &mut Scene, text: &str, path: &Path, loaded: &Meshes) -> R
         match mesh {
             Ok(mesh) => scene.meshes.insert(file.clone(), mesh),
             Err(error) => {
-                let at = Invalid {
-                    field: String::new(),
-                    section: "objects",
-                    index: Some(index),
-                    item: None,
-                    key: "file",
-                    problem: Problem::MeshNotLoaded(String::new()),
-                };
-                let (line, column) = locate(text, &at);
+                let (line, column) = locate(text, "objects", Some(index), "file");
                 return Err(SceneFileError::Mesh { path: path.to_owned(), line, column, error: Box::new(error) });
             }
         }
@@ -118,16 +110,16 @@ pub fn save_scene(scene: &Scene, path: &Path) -> Result<(), SceneFileError> {
 /// Where an invalid value sits in the text: the section, then its list's
 /// item by place (RON gives no spans after deserialising; names can repeat
 /// and be written in any field order), then `key:` within that item.
-fn locate(text: &str, invalid: &Invalid) -> (usize, usize) {
-    let section = if invalid.section == "scene" { Some(0) } else { find_key(text, 0, invalid.section) };
+fn locate(text: &str, section: &str, index: Option<usize>, key: &str) -> (usize, usize) {
+    let section = if section == "scene" { Some(0) } else { find_key(text, 0, section) };
     let mut at = section.unwrap_or(0);
     let mut end = text.len();
-    if let (Some(section), Some(index)) = (section, invalid.index) {
+    if let (Some(section), Some(index)) = (section, index) {
         if let Some(item) = list_item(text, section, index) {
             (at, end) = (item.start, item.end);
         }
     }
-    if let Some(found) = find_key(&text[..end], at, invalid.key) {
+    if let Some(found) = find_key(&text[..end], at, key) {
         at = found;
     }
     line_column(text, at)

@@ -212,16 +212,16 @@ fn unit_scale() -> f32 {
 }
 
 impl Shape {
-    /// Where a mesh's file puts a point (`Mesh`'s placement); the point
-    /// itself for any other shape.
-    pub fn place(&self, point: Vec3) -> Vec3 {
+    /// Where a mesh's file puts its points (`Mesh`'s placement: scale,
+    /// then turn about x, y, z, then move); nothing for any other shape.
+    pub fn placement(&self) -> glam::Affine3A {
         match *self {
             Shape::Mesh { translate, scale, rotate_degrees, .. } => {
                 let r = rotate_degrees * (std::f32::consts::PI / 180.0);
                 let rotation = glam::Quat::from_euler(glam::EulerRot::ZYX, r.z, r.y, r.x);
-                rotation * (point * scale) + translate
+                glam::Affine3A::from_scale_rotation_translation(Vec3::splat(scale), rotation, translate)
             }
-            _ => point,
+            _ => glam::Affine3A::IDENTITY,
         }
     }
 }

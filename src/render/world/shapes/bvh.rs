@@ -175,10 +175,6 @@ impl Bvh {
         Some(middle)
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.order.is_empty()
-    }
-
     /// The ray as the box tests take it: its origin and the inverse of its
     /// direction in every lane, a zero component's inverse huge but finite
     /// (an infinite one times a zero distance would be NaN).

@@ -178,7 +178,11 @@ impl Shapes {
                     // A valid scene has every mesh it names loaded
                     let first = triangles.len() as u32;
                     let loaded = meshes.get(file).map_or(&[][..], |mesh| &mesh.triangles[..]);
-                    let placed = |t: &[Vec3; 3]| Triangle::new(shape.place(t[0]), shape.place(t[1]), shape.place(t[2]));
+                    let placement = shape.placement();
+                    let placed = |t: &[Vec3; 3]| {
+                        let [a, b, c] = t.map(|v| placement.transform_point3(v));
+                        Triangle::new(a, b, c)
+                    };
                     triangles.extend(loaded.iter().map(|t| (placed(t), object)));
                     ShapeRef::Mesh { first, count: triangles.len() as u32 - first }
                 }
