@@ -91,6 +91,10 @@ pub const K_NEAREST: Limit<u32> = Limit::inclusive(8, 10_000);
 pub const GATHER_RAYS: Limit<u32> = Limit::inclusive(1, 4096);
 /// Radii, clamps and other lengths: finite and not negative.
 pub const LENGTH: Limit<f32> = Limit::inclusive(0.0, f32::MAX);
+/// A microfacet surface's α: 1 is already as rough as GGX surfaces are drawn.
+pub const ROUGHNESS: Limit<f32> = Limit::inclusive(0.0, 1.0);
+/// Each part of a metal's complex index, η and k (the measured metals' lie within 0.1–10).
+pub const METAL_INDEX: Limit<f32> = Limit::inclusive(0.0, 100.0);
 pub const SPPM_ALPHA: Limit<f32> = Limit::above(0.0, 1.0);
 /// Photons stored in one map read from a file.
 pub const STORED_PHOTONS: u64 = 200_000_000;

@@ -79,6 +79,14 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("glossy", "bdpt", 0x3af334f206b3eb9b),
     ("glossy", "bpm", 0x35f6f40d372672f9),
     ("glossy", "vcm", 0x3af334f206b3eb9b),
+    ("metals", "whitted", 0x6ac148cf7b066693),
+    ("metals", "path", 0xbac0ab3b42e86a0e),
+    ("metals", "photon", 0xcbef8e81fb8c360e),
+    ("metals", "sppm", 0x2f4db4a4f2a6c632),
+    ("metals", "lt", 0x0a2cff20c61e8340),
+    ("metals", "bdpt", 0x188ff45aa7284e93),
+    ("metals", "bpm", 0x2ea1c41abb573fd6),
+    ("metals", "vcm", 0x188ff45aa7284e93),
     ("cornell", "vcm+everywhere", 0x1b195b7b4ffa81a9),
     ("smallpt", "vcm+everywhere", 0xe02f1f9239cdf1cd),
     ("thesis", "vcm+everywhere", 0xc4fc44659adbf1dd),
@@ -87,6 +95,7 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("mirror-caustic", "vcm+everywhere", 0xa9b3a4fe8e0ceb20),
     ("gap-room", "vcm+everywhere", 0xae39874d96921092),
     ("glossy", "vcm+everywhere", 0x74cd4f4fe0275727),
+    ("metals", "vcm+everywhere", 0x34a9db20195cc7ca),
 ];
 
 pub fn image_hash(image: &LinearImage) -> u64 {
@@ -129,13 +138,14 @@ fn every_preset_and_algorithm_renders_its_golden_image() {
     assert!(changed.is_empty(), "images changed; if intended, commit them on their own with:\n{}", changed.join("\n"));
 }
 
-/// Where no light passes a mirror or glass (lights, gap-room, glossy), VCM
+/// Where no light passes a mirror or glass (lights, gap-room, glossy,
+/// metals), VCM
 /// (merging on caustic paths only) has no merge to make and weighs every
 /// connection as BDPT does: its image is BDPT's, bit for bit. A merge's
 /// share left in any connection's weight would darken it.
 #[test]
 fn caustic_merges_without_mirrors_or_glass_are_bdpt() {
-    for preset in ["lights", "gap-room", "glossy"] {
+    for preset in ["lights", "gap-room", "glossy", "metals"] {
         let (vcm, bdpt) = (golden_render(preset, "vcm"), golden_render(preset, "bdpt"));
         assert!(vcm.pixels == bdpt.pixels, "{preset}: VCM with caustic merges is not BDPT");
     }

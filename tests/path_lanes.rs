@@ -10,7 +10,9 @@ use gi_studio::render::world::camera::TileRect;
 use gi_studio::render::world::lane_world::LaneWorld;
 use gi_studio::render::world::rng::PassStreams;
 use gi_studio::render::world::World;
-use gi_studio::scene::{presets, Attenuation, Light, LightKind, MaterialModel, Object, Rgb, Scene, Shape, ValidScene};
+use gi_studio::scene::{
+    presets, Attenuation, Light, LightKind, MaterialModel, Metal, Object, Rgb, Scene, Shape, ValidScene,
+};
 use glam::Vec3;
 
 fn light(kind: LightKind, intensity: f32) -> Light {
@@ -276,11 +278,12 @@ fn paths_outside_the_walls_bit_for_bit() {
     assert!(lit > 500, "only {lit} samples carried light");
 }
 
-/// Phong and Blinn–Phong surfaces (thesis, glossy) and a sky as a light
-/// (thesis, and the Cornell box open to one) take the lanes, bit for bit.
+/// Phong and Blinn–Phong surfaces (thesis, glossy), rough metals (metals)
+/// and a sky as a light (thesis, and the Cornell box open to one) take the
+/// lanes, bit for bit.
 #[test]
 fn glossy_lobes_and_skies_bit_for_bit() {
-    for (name, least) in [("thesis", 1000), ("glossy", 1000)] {
+    for (name, least) in [("thesis", 1000), ("glossy", 1000), ("metals", 300)] {
         let lit = assert_lanes_match_scalar(&preset(name), 32, 2);
         assert!(lit > least, "{name}: only {lit} samples carried light");
     }
@@ -290,6 +293,15 @@ fn glossy_lobes_and_skies_bit_for_bit() {
     sky.objects.retain(|object| object.name != "ceiling");
     let lit = assert_lanes_match_scalar(&sky, 32, 2);
     assert!(lit > 1000, "a sky: only {lit} samples carried light");
+    // The red and green walls polished and rough metal, the mirror ball
+    // anisotropic, beside white walls and glass
+    let mut metals = preset("cornell");
+    for (material, (alpha_u, alpha_v)) in metals.materials.iter_mut().skip(1).zip([(0.0, 0.0), (0.3, 0.3), (0.05, 0.5)])
+    {
+        material.model = MaterialModel::Conductor { metal: Metal::Copper, alpha_u, alpha_v };
+    }
+    let lit = assert_lanes_match_scalar(&metals, 32, 2);
+    assert!(lit > 1000, "metals: only {lit} samples carried light");
 }
 
 /// The tests above compare the eight lanes with the scalar code only where

@@ -18,7 +18,7 @@ use common::detectors;
 /// presets are covered by the convergence benchmark instead.
 #[test]
 fn low_spp_renders_agree_with_the_references_pixel_by_pixel() {
-    for name in ["thesis", "lights"] {
+    for name in ["thesis", "lights", "metals"] {
         if let Err(e) = detectors::path_tracing_agrees_with_its_reference(name) {
             panic!("{e}");
         }

@@ -403,6 +403,52 @@ fn a_new_sphere_is_placed_where_the_camera_looks() {
     assert_eq!(seen, Some(added), "the new sphere is not where the camera looks");
 }
 
+/// A material turned into a metal in the inspector, and the metal chosen:
+/// each choice an edit that restarts the panes, each undone in one step;
+/// the roughness slider moves both axes of an isotropic metal.
+#[test]
+fn a_material_becomes_a_metal_in_the_inspector() {
+    use gi_studio::scene::{MaterialModel, Metal};
+    let model_of = |app: &StudioApp| app.scene().materials.iter().find(|m| m.name == "glass").map(|m| m.model.clone());
+    let mut harness = studio(1);
+    step_until(&mut harness, |app| app.panes().list()[0].state().passes() >= 1);
+    let original = harness.state().scene().clone();
+    harness.get_by_label("glass (Glass)").click();
+    harness.run_steps(2);
+    harness.get_by_label("Model").click();
+    harness.run_steps(2);
+    harness.get_by_label("Metal").click();
+    harness.run_steps(2);
+    let gold = MaterialModel::Conductor { metal: Metal::Gold, alpha_u: 0.1, alpha_v: 0.1 };
+    assert_eq!(model_of(harness.state()), Some(gold.clone()));
+    let generation = harness.state().panes().generations()[0];
+    harness.get_by_label("Made of").click();
+    harness.run_steps(2);
+    harness.get_by_label("Copper").click();
+    harness.run_steps(3);
+    let copper = MaterialModel::Conductor { metal: Metal::Copper, alpha_u: 0.1, alpha_v: 0.1 };
+    assert_eq!(model_of(harness.state()), Some(copper.clone()));
+    assert!(harness.state().panes().generations()[0] > generation, "choosing the metal must restart the render");
+    // A click on the slider's middle makes the surface rougher, on both axes
+    harness.get_by_role_and_label(Role::Slider, "Roughness α").click();
+    harness.run_steps(3);
+    match model_of(harness.state()) {
+        Some(MaterialModel::Conductor { metal: Metal::Copper, alpha_u, alpha_v }) => {
+            assert!(alpha_u > 0.3 && alpha_u == alpha_v, "α {alpha_u}, {alpha_v}")
+        }
+        other => panic!("{other:?}"),
+    }
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(model_of(harness.state()), Some(copper));
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(model_of(harness.state()), Some(gold));
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert_eq!(*harness.state().scene(), original);
+}
+
 /// A drag of 80 points turns the Cornell box's camera by a few degrees
 /// (the field of view per image height), not out through its walls.
 #[test]

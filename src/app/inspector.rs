@@ -9,7 +9,10 @@ use glam::Vec3;
 use super::document::{unique_name, Spot};
 use super::widgets::{committed_text_ui, number, slider};
 
-use crate::scene::{Attenuation, ClipAlong, Invalid, Light, LightKind, Material, MaterialModel, Object, Scene, Shape};
+use crate::limits;
+use crate::scene::{
+    Attenuation, ClipAlong, Invalid, Light, LightKind, Material, MaterialModel, Metal, Object, Scene, Shape,
+};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Selection {
@@ -400,6 +403,7 @@ fn material_model_ui(ui: &mut egui::Ui, model: &mut MaterialModel) -> bool {
         MaterialModel::Phong { kd, ks, .. } | MaterialModel::BlinnPhong { kd, ks, .. } => (*kd, *ks),
         MaterialModel::Mirror { tint } | MaterialModel::Glass { tint, .. } => (*tint * 0.5, *tint * 0.5),
         MaterialModel::Emissive { radiance } => (radiance.min(Vec3::ONE), Vec3::ZERO),
+        MaterialModel::Conductor { metal, .. } => (metal.normal_reflectance() * 0.5, metal.normal_reflectance() * 0.5),
     };
     let choices = [
         MaterialModel::Lambert { albedo: kd },
@@ -407,6 +411,7 @@ fn material_model_ui(ui: &mut egui::Ui, model: &mut MaterialModel) -> bool {
         MaterialModel::BlinnPhong { ka: kd, kd, ks: ks.max(Vec3::splat(0.2)).min(Vec3::ONE - kd), shininess: 60.0 },
         MaterialModel::Mirror { tint: Vec3::splat(0.95) },
         MaterialModel::Glass { ior: 1.5, tint: Vec3::ONE },
+        MaterialModel::Conductor { metal: Metal::Gold, alpha_u: 0.1, alpha_v: 0.1 },
         MaterialModel::Emissive { radiance: Vec3::splat(5.0) },
     ];
     let mut changed = false;
@@ -436,7 +441,46 @@ fn material_model_ui(ui: &mut egui::Ui, model: &mut MaterialModel) -> bool {
                 changed | reflectance_ui(ui, "Tint", tint)
             }
             MaterialModel::Emissive { radiance } => radiance_ui(ui, "Radiance", radiance),
+            MaterialModel::Conductor { metal, alpha_u, alpha_v } => conductor_ui(ui, metal, alpha_u, alpha_v),
         }
+}
+
+/// A metal by name or by its index, and its roughness: one slider for an
+/// isotropic surface (it carries α v along while the two are equal), a
+/// second for α v alone.
+fn conductor_ui(ui: &mut egui::Ui, metal: &mut Metal, alpha_u: &mut f32, alpha_v: &mut f32) -> bool {
+    let mut changed = false;
+    egui::ComboBox::from_label("Made of").selected_text(metal.label()).show_ui(ui, |ui| {
+        let (eta, k) = metal.index();
+        for choice in Metal::NAMED.into_iter().chain([Metal::Custom { eta, k }]) {
+            if ui.selectable_label(choice.label() == metal.label(), choice.label()).clicked()
+                && choice.label() != metal.label()
+            {
+                *metal = choice;
+                changed = true;
+            }
+        }
+    });
+    if let Metal::Custom { eta, k } = metal {
+        for (label, v) in [("η", eta), ("k", k)] {
+            ui.horizontal(|ui| {
+                let label = ui.label(label);
+                for c in [&mut v.x, &mut v.y, &mut v.z] {
+                    let range = limits::METAL_INDEX.min..=limits::METAL_INDEX.max;
+                    changed |= ui.add(number(c).speed(0.01).range(range)).labelled_by(label.id).changed();
+                }
+            });
+        }
+    }
+    let range = limits::ROUGHNESS.min..=limits::ROUGHNESS.max;
+    let isotropic = *alpha_u == *alpha_v;
+    if ui.add(slider(alpha_u, range.clone()).text("Roughness α")).changed() {
+        if isotropic {
+            *alpha_v = *alpha_u;
+        }
+        changed = true;
+    }
+    changed | ui.add(slider(alpha_v, range).text("α v (anisotropic)")).changed()
 }
 
 fn light_kind_ui(ui: &mut egui::Ui, kind: &mut LightKind) -> bool {

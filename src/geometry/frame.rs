@@ -49,6 +49,12 @@ pub fn to_world<R: Real>(frame: [V3<R>; 3], v: V3<R>) -> V3<R> {
     frame[0] * v.x + frame[1] * v.y + frame[2] * v.z
 }
 
+/// `v` (in the world's coordinates) in the frame's.
+#[inline(always)]
+pub fn to_local<R: Real>(frame: [V3<R>; 3], v: V3<R>) -> V3<R> {
+    V3::new(v.dot(frame[0]), v.dot(frame[1]), v.dot(frame[2]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

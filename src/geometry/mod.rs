@@ -12,7 +12,7 @@ pub mod sphere;
 mod triangle;
 
 pub use cull::{beyond, Crossing, CullEdges, CullPlane, TriangleCull};
-pub use frame::{frame_from_z, to_world, Frame};
+pub use frame::{frame_from_z, to_local, to_world, Frame};
 pub use plane::intersect_plane;
 pub(crate) use plane::{plane_exit_of, plane_exit_t, plane_hit, plane_point_of, plane_t, plane_t_of};
 pub use ray::{gamma, offset_origin, offset_ray_origin, spawn_offset_scale, Ray};

@@ -136,6 +136,16 @@ pub enum MaterialModel {
         ior: f32,
         tint: Rgb,
     },
+    /// A metal: Fresnel's reflection of `metal`'s complex index on GGX
+    /// microfacets of roughness α (the slopes' width, as Mitsuba and pbrt
+    /// take it; `alpha_u` along the first axis of the frame about the
+    /// normal, `alpha_v` along the second); both below
+    /// `SMOOTH_ALPHA` is a polished metal, a mirror whose colour is Fresnel's.
+    Conductor {
+        metal: Metal,
+        alpha_u: f32,
+        alpha_v: f32,
+    },
     /// A black surface that emits `radiance` from its front side (outward for
     /// spheres, along the normal for planes and triangles): an area light.
     Emissive {
@@ -151,6 +161,7 @@ impl MaterialModel {
             Self::BlinnPhong { .. } => "Blinn–Phong",
             Self::Mirror { .. } => "Mirror",
             Self::Glass { .. } => "Glass",
+            Self::Conductor { .. } => "Metal",
             Self::Emissive { .. } => "Emissive",
         }
     }
@@ -161,8 +172,69 @@ impl MaterialModel {
         match *self {
             Self::Lambert { albedo } => albedo,
             Self::Phong { ka, .. } | Self::BlinnPhong { ka, .. } => ka,
+            Self::Conductor { metal, .. } => metal.normal_reflectance(),
             Self::Mirror { .. } | Self::Glass { .. } | Self::Emissive { .. } => Rgb::ZERO,
         }
+    }
+
+    /// Only delta lobes: mirrors, glass and polished metals.
+    pub fn is_specular(&self) -> bool {
+        match *self {
+            Self::Mirror { .. } | Self::Glass { .. } => true,
+            Self::Conductor { alpha_u, alpha_v, .. } => alpha_u.max(alpha_v) < SMOOTH_ALPHA,
+            Self::Lambert { .. } | Self::Phong { .. } | Self::BlinnPhong { .. } | Self::Emissive { .. } => false,
+        }
+    }
+}
+
+/// Below this roughness a metal is polished: its lobe would be narrower
+/// than a pixel's worth of directions and sampling lights toward it wasted.
+pub const SMOOTH_ALPHA: f32 = 1e-3;
+
+/// A conductor's complex index of refraction η + ik per RGB channel. The
+/// named metals' values are measured spectra (Palik's, as Mitsuba 3
+/// ships them) reduced to RGB the way Mitsuba's RGB variants reduce them,
+/// so a metal renders the colour it has there.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Metal {
+    Gold,
+    Silver,
+    Copper,
+    Aluminium,
+    Custom { eta: Rgb, k: Rgb },
+}
+
+impl Metal {
+    pub const NAMED: [Metal; 4] = [Metal::Gold, Metal::Silver, Metal::Copper, Metal::Aluminium];
+
+    /// (η, k).
+    pub fn index(&self) -> (Rgb, Rgb) {
+        match *self {
+            Metal::Gold => (Vec3::new(0.143_036, 0.375_307, 1.442_05), Vec3::new(3.983, 2.385_56, 1.603_36)),
+            Metal::Silver => (Vec3::new(0.155_276, 0.116_728, 0.138_388), Vec3::new(4.828_35, 3.122_22, 2.146_9)),
+            Metal::Copper => (Vec3::new(0.201_005, 0.923_75, 1.102_22), Vec3::new(3.913_26, 2.453_05, 2.142_09)),
+            Metal::Aluminium => (Vec3::new(1.657_5, 0.880_405, 0.521_244), Vec3::new(9.223_81, 6.269_5, 4.837)),
+            Metal::Custom { eta, k } => (eta, k),
+        }
+    }
+
+    pub fn label(&self) -> &'static str {
+        match self {
+            Metal::Gold => "Gold",
+            Metal::Silver => "Silver",
+            Metal::Copper => "Copper",
+            Metal::Aluminium => "Aluminium",
+            Metal::Custom { .. } => "Custom",
+        }
+    }
+
+    /// Fresnel's reflectance at normal incidence, ((η−1)² + k²)/((η+1)² + k²):
+    /// the metal's colour.
+    pub fn normal_reflectance(&self) -> Rgb {
+        let (eta, k) = self.index();
+        let k2 = k * k;
+        ((eta - Vec3::ONE) * (eta - Vec3::ONE) + k2) / ((eta + Vec3::ONE) * (eta + Vec3::ONE) + k2)
     }
 }
 

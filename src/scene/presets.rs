@@ -15,6 +15,7 @@ pub const PRESETS: &[(&str, &str)] = &[
     ("mirror-caustic", include_str!("../../assets/scenes/mirror-caustic.ron")),
     ("gap-room", include_str!("../../assets/scenes/gap-room.ron")),
     ("glossy", include_str!("../../assets/scenes/glossy.ron")),
+    ("metals", include_str!("../../assets/scenes/metals.ron")),
 ];
 
 pub fn names() -> impl Iterator<Item = &'static str> {

@@ -6,7 +6,7 @@ use std::collections::HashSet;
 use glam::Vec3;
 
 use super::differences::shown as shown_name;
-use super::{LightKind, MaterialModel, Scene, Shape};
+use super::{LightKind, MaterialModel, Metal, Scene, Shape};
 use crate::limits;
 
 /// One invalid value: where it is (a readable path plus what the file locator
@@ -120,6 +120,12 @@ impl<'a> Checker<'a> {
         }
     }
 
+    fn within(&mut self, key: &'static str, v: f32, limit: limits::Limit<f32>) {
+        if self.finite(key, v) && !limit.contains(v) {
+            self.report(key, Problem::OutOfRange { min: limit.min, max: limit.max, found: v });
+        }
+    }
+
     fn colour(&mut self, key: &'static str, v: Vec3) {
         if self.vector(key, v) {
             if let Some(c) = v.to_array().into_iter().find(|c| *c < 0.0) {
@@ -183,11 +189,7 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
     if side.contains(width) && side.contains(height) && width as u64 * height as u64 > limits::IMAGE_PIXELS {
         check.report("height", Problem::TooManyPixels { width, height });
     }
-    let exposure = scene.settings.exposure;
-    let stops = limits::EXPOSURE_STOPS;
-    if check.finite("exposure", exposure) && !stops.contains(exposure) {
-        check.report("exposure", Problem::OutOfRange { min: stops.min, max: stops.max, found: exposure });
-    }
+    check.within("exposure", scene.settings.exposure, limits::EXPOSURE_STOPS);
     check.at("scene", None, None, "");
     check.colour("background", scene.background);
     check.colour("ambient", scene.ambient);
@@ -209,6 +211,16 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
             MaterialModel::Glass { ior, tint } => {
                 check.positive("ior", *ior);
                 check.reflectance("tint", *tint);
+            }
+            MaterialModel::Conductor { metal, alpha_u, alpha_v } => {
+                check.within("alpha_u", *alpha_u, limits::ROUGHNESS);
+                check.within("alpha_v", *alpha_v, limits::ROUGHNESS);
+                if let Metal::Custom { eta, k } = metal {
+                    check.at("materials", Some(i), Some(&material.name), ".model.metal");
+                    for (key, v) in [("eta", eta), ("k", k)] {
+                        v.to_array().into_iter().for_each(|c| check.within(key, c, limits::METAL_INDEX));
+                    }
+                }
             }
             MaterialModel::Emissive { radiance } => check.colour("radiance", *radiance),
         }

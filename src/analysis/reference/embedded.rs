@@ -47,6 +47,11 @@ const EMBEDDED: &[(&str, &[u8], &str)] = &[
         include_bytes!("../../../assets/references/glossy.exr"),
         include_str!("../../../assets/references/glossy.exr.meta.ron"),
     ),
+    (
+        "metals",
+        include_bytes!("../../../assets/references/metals.exr"),
+        include_str!("../../../assets/references/metals.exr.meta.ron"),
+    ),
 ];
 
 /// The compiled-in reference of `scene`, if it is a preset as shipped.

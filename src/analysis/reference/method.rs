@@ -34,7 +34,7 @@ pub fn reference_method(scene: &Scene) -> ReferenceMethod {
     let delta_light = scene.lights.iter().any(|l| l.enabled && l.intensity > 0.0 && l.color.max_element() > 0.0);
     let specular = scene.objects.iter().any(|o| {
         let model = scene.material_index(&o.material).map(|m| &scene.materials[m].model);
-        matches!(model, Some(MaterialModel::Mirror { .. } | MaterialModel::Glass { .. }))
+        model.is_some_and(MaterialModel::is_specular)
     });
     match (delta_light, specular) {
         (true, true) => ReferenceMethod {

@@ -7,7 +7,11 @@
 
 use glam::Vec3;
 
-use super::{At, BlinnPhong, Bsdf, Draws, Glass, Lambert, Mirror, Phong, Sampled, Scatter, Transport};
+use super::microfacet::Ggx;
+use super::{
+    At, BlinnPhong, Bsdf, Draws, Glass, Lambert, Mirror, Phong, RoughConductor, Sampled, Scatter, SmoothConductor,
+    Transport,
+};
 use crate::render::world::lanes::{Column, Column3, Index8, Rng8, F8, M8, V8};
 use crate::scene::{MaterialModel, Rgb};
 
@@ -18,6 +22,8 @@ const GLASS: f32 = 2.0;
 const EMITTER: f32 = 3.0;
 const PHONG: f32 = 4.0;
 const BLINN_PHONG: f32 = 5.0;
+const ROUGH_CONDUCTOR: f32 = 6.0;
+const SMOOTH_CONDUCTOR: f32 = 7.0;
 
 impl Draws<F8> for Rng8 {
     #[inline(always)]
@@ -47,6 +53,11 @@ pub(crate) struct Record {
     exponent: f32,
     diffuse_probability: f32,
     normalisation: f32,
+    /// A metal's complex index and its roughness along the frame's axes.
+    eta: Rgb,
+    k: Rgb,
+    alpha_x: f32,
+    alpha_y: f32,
 }
 
 impl Record {
@@ -60,6 +71,10 @@ impl Record {
             exponent: 0.0,
             diffuse_probability: 1.0,
             normalisation: 0.0,
+            eta: Rgb::ONE,
+            k: Rgb::ZERO,
+            alpha_x: 1.0,
+            alpha_y: 1.0,
         };
         match Bsdf::new(material) {
             Bsdf::Lambert(m) => plain(LAMBERT, m.albedo.into()),
@@ -78,6 +93,16 @@ impl Record {
                 normalisation: m.normalisation,
                 ..plain(BLINN_PHONG, m.kd.into())
             },
+            Bsdf::RoughConductor(m) => Record {
+                eta: m.eta.into(),
+                k: m.k.into(),
+                alpha_x: m.ggx.alpha_x,
+                alpha_y: m.ggx.alpha_y,
+                ..plain(ROUGH_CONDUCTOR, Rgb::ZERO)
+            },
+            Bsdf::SmoothConductor(m) => {
+                Record { eta: m.eta.into(), k: m.k.into(), ..plain(SMOOTH_CONDUCTOR, Rgb::ZERO) }
+            }
             Bsdf::Black => match *material {
                 MaterialModel::Emissive { radiance } => plain(EMITTER, radiance),
                 // Reflects nothing, emits nothing: an emitter gone dark
@@ -99,6 +124,10 @@ pub(crate) struct MaterialTable {
     exponent: Column,
     diffuse_probability: Column,
     normalisation: Column,
+    eta: Column3,
+    k: Column3,
+    alpha_x: Column,
+    alpha_y: Column,
 }
 
 impl MaterialTable {
@@ -115,6 +144,10 @@ impl MaterialTable {
             exponent: column(|r| r.exponent),
             diffuse_probability: column(|r| r.diffuse_probability),
             normalisation: column(|r| r.normalisation),
+            eta: column3(|r| r.eta),
+            k: column3(|r| r.k),
+            alpha_x: column(|r| r.alpha_x),
+            alpha_y: column(|r| r.alpha_y),
             records,
         }
     }
@@ -158,6 +191,8 @@ pub(crate) struct LaneSurfaces<'a> {
     blinn_phong: M8,
     mirror: M8,
     glass: M8,
+    rough_conductor: M8,
+    smooth_conductor: M8,
     /// Emitters, and surfaces that neither reflect nor emit.
     pub(crate) emissive: M8,
     /// Albedo, tint, radiance or a glossy surface's diffuse part.
@@ -165,6 +200,8 @@ pub(crate) struct LaneSurfaces<'a> {
     /// The glossy lanes' lobes (zeros where no lane is glossy).
     phong_lobe: Phong<F8>,
     blinn_phong_lobe: BlinnPhong<F8>,
+    /// The rough metals' lobes (a dummy where no lane is a rough metal).
+    rough_conductor_lobe: RoughConductor<F8>,
 }
 
 impl<'a> LaneSurfaces<'a> {
@@ -188,16 +225,32 @@ impl<'a> LaneSurfaces<'a> {
             ),
             false => (V8::splat(Vec3::ZERO), F8::splat(0.0), F8::splat(0.0), F8::splat(0.0)),
         };
+        let rough_conductor = kind(ROUGH_CONDUCTOR);
+        let rough_conductor_lobe = match rough_conductor.any() {
+            true => RoughConductor {
+                eta: table.eta.get(index),
+                k: table.k.get(index),
+                ggx: Ggx { alpha_x: table.alpha_x.get(index), alpha_y: table.alpha_y.get(index) },
+            },
+            false => RoughConductor {
+                eta: V8::splat(Vec3::ONE),
+                k: V8::splat(Vec3::ZERO),
+                ggx: Ggx { alpha_x: F8::splat(1.0), alpha_y: F8::splat(1.0) },
+            },
+        };
         LaneSurfaces {
             lambert: kind(LAMBERT),
             phong,
             blinn_phong,
             mirror: kind(MIRROR),
             glass: kind(GLASS),
+            rough_conductor,
+            smooth_conductor: kind(SMOOTH_CONDUCTOR),
             emissive: kind(EMITTER),
             color,
             phong_lobe: Phong { kd: color, ks, exponent, diffuse_probability },
             blinn_phong_lobe: BlinnPhong { kd: color, ks, exponent, diffuse_probability, normalisation },
+            rough_conductor_lobe,
             table,
             index,
         }
@@ -211,19 +264,22 @@ impl<'a> LaneSurfaces<'a> {
         self.blinn_phong = self.blinn_phong.and(lanes);
         self.mirror = self.mirror.and(lanes);
         self.glass = self.glass.and(lanes);
+        self.rough_conductor = self.rough_conductor.and(lanes);
+        self.smooth_conductor = self.smooth_conductor.and(lanes);
         self.emissive = self.emissive.and(lanes);
     }
 
-    /// `Bsdf::is_specular`: mirrors, glass, and what reflects nothing.
+    /// `Bsdf::is_specular`: mirrors, glass, polished metals, and what
+    /// reflects nothing.
     #[inline(always)]
     pub(crate) fn specular(&self) -> M8 {
-        self.mirror.or(self.glass).or(self.emissive)
+        self.mirror.or(self.glass).or(self.smooth_conductor).or(self.emissive)
     }
 
     /// The lanes whose surface is not specular: where lights are sampled.
     #[inline(always)]
     pub(crate) fn shaded(&self) -> M8 {
-        self.lambert.or(self.phong).or(self.blinn_phong)
+        self.lambert.or(self.phong).or(self.blinn_phong).or(self.rough_conductor)
     }
 
     /// `Bsdf::eval_pdf` for `wo` and `wi` above the surface of normal `n`,
@@ -241,6 +297,11 @@ impl<'a> LaneSurfaces<'a> {
         if blinn_phong.any() {
             let (blinn_f, blinn_pdf) = self.blinn_phong_lobe.eval_pdf(wo, wi, n);
             (f, pdf) = (blinn_phong.select_v(blinn_f, f), blinn_phong.select(blinn_pdf, pdf));
+        }
+        let rough_conductor = self.rough_conductor.and(wanted);
+        if rough_conductor.any() {
+            let (metal_f, metal_pdf) = self.rough_conductor_lobe.eval_pdf(wo, wi, n);
+            (f, pdf) = (rough_conductor.select_v(metal_f, f), rough_conductor.select(metal_pdf, pdf));
         }
         (f, pdf)
     }
@@ -271,6 +332,14 @@ impl<'a> LaneSurfaces<'a> {
         if self.glass.any() {
             let glass = Glass { ior: self.table.ior.get(self.index), tint: self.color };
             out.take(self.glass, glass.sample(self.glass, &at, rng, transport));
+        }
+        if self.rough_conductor.any() {
+            let sampled = self.rough_conductor_lobe.sample(self.rough_conductor, &at, rng, transport);
+            out.take(self.rough_conductor, sampled);
+        }
+        if self.smooth_conductor.any() {
+            let metal = SmoothConductor { eta: self.table.eta.get(self.index), k: self.table.k.get(self.index) };
+            out.take(self.smooth_conductor, metal.sample(self.smooth_conductor, &at, rng, transport));
         }
         out
     }

@@ -1,5 +1,6 @@
 //! What a surface does to light. Each material is written once, in its own
-//! file (`lambert`, `phong`, `blinn_phong`, `mirror`, `glass`), as a type
+//! file (`lambert`, `phong`, `blinn_phong`, `mirror`, `glass`,
+//! `conductor`; the rough ones made of `microfacet`'s GGX), as a type
 //! generic over `Real` implementing `Scatter`: the scalar code reaches it
 //! through `Bsdf`, the closed list every algorithm dispatches through, and
 //! the eight lanes through `lanes::LaneSurfaces`, which runs each material
@@ -17,16 +18,20 @@ macro_rules! each_material {
             Bsdf::BlinnPhong($m) => $body,
             Bsdf::Mirror($m) => $body,
             Bsdf::Glass($m) => $body,
+            Bsdf::RoughConductor($m) => $body,
+            Bsdf::SmoothConductor($m) => $body,
             Bsdf::Black => $black,
         }
     };
 }
 
 mod blinn_phong;
+mod conductor;
 mod glass;
 mod glossy;
 mod lambert;
 pub(crate) mod lanes;
+pub mod microfacet;
 mod mirror;
 mod optics;
 mod phong;
@@ -37,16 +42,17 @@ mod thesis;
 use glam::Vec3;
 
 pub use blinn_phong::BlinnPhong;
+pub use conductor::{RoughConductor, SmoothConductor};
 pub use glass::Glass;
 pub use lambert::Lambert;
 pub use mirror::Mirror;
-pub use optics::{fresnel_dielectric, reflect, reflect_of, refract, refraction_of, Refraction};
+pub use optics::{fresnel_conductor_of, fresnel_dielectric, reflect, reflect_of, refract, refraction_of, Refraction};
 pub use phong::Phong;
 pub use thesis::{Brought, Shares, Thesis};
 
 use crate::geometry::real::{Real, V3};
 use crate::render::world::rng::Sampler;
-use crate::scene::{MaterialModel, Rgb};
+use crate::scene::{MaterialModel, Metal, Rgb, SMOOTH_ALPHA};
 
 /// What a path carries through refraction: camera paths carry radiance, which
 /// is compressed by η² entering a denser medium; photons carry power, which is not.
@@ -146,6 +152,8 @@ pub enum Bsdf {
     BlinnPhong(BlinnPhong<f32>),
     Mirror(Mirror<f32>),
     Glass(Glass<f32>),
+    RoughConductor(RoughConductor<f32>),
+    SmoothConductor(SmoothConductor<f32>),
     /// Emitters reflect nothing.
     Black,
 }
@@ -175,6 +183,7 @@ impl Bsdf {
             MaterialModel::BlinnPhong { kd, ks, shininess, .. } => Bsdf::blinn_phong(kd, ks, shininess),
             MaterialModel::Mirror { tint } => Bsdf::mirror(tint),
             MaterialModel::Glass { ior, tint } => Bsdf::glass(ior, tint),
+            MaterialModel::Conductor { metal, alpha_u, alpha_v } => Bsdf::conductor(metal, alpha_u, alpha_v),
             MaterialModel::Emissive { .. } => Bsdf::Black,
         }
     }
@@ -197,6 +206,19 @@ impl Bsdf {
 
     pub fn glass(ior: f32, tint: Rgb) -> Self {
         Bsdf::Glass(Glass { ior, tint: tint.into() })
+    }
+
+    /// A metal of roughness α_u, α_v: polished below `SMOOTH_ALPHA` on both
+    /// axes (`MaterialModel::is_specular`).
+    pub fn conductor(metal: Metal, alpha_u: f32, alpha_v: f32) -> Self {
+        let (eta, k) = metal.index();
+        let (eta, k) = (eta.into(), k.into());
+        if alpha_u.max(alpha_v) < SMOOTH_ALPHA {
+            return Bsdf::SmoothConductor(SmoothConductor { eta, k });
+        }
+        // A lobe narrower than SMOOTH_ALPHA on one axis only is kept that wide
+        let ggx = microfacet::Ggx { alpha_x: alpha_u.max(SMOOTH_ALPHA), alpha_y: alpha_v.max(SMOOTH_ALPHA) };
+        Bsdf::RoughConductor(RoughConductor { eta, k, ggx })
     }
 
     /// Only delta lobes: no light sampling, no photon storage.

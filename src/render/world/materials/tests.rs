@@ -3,6 +3,7 @@
 use super::glossy::diffuse_probability;
 use super::*;
 use crate::render::world::sampling::uniform_sphere;
+use crate::scene::Metal;
 
 fn directional_albedo(bsdf: &Bsdf, wo: Vec3, n: usize) -> Rgb {
     let mut s = Sampler::new(0, 0, 5);
@@ -20,6 +21,8 @@ fn sampled_weight_matches_eval_over_pdf() {
     let bsdfs = [
         Bsdf::phong(Vec3::splat(0.3), Vec3::splat(0.6), 20.0),
         Bsdf::blinn_phong(Vec3::splat(0.2), Vec3::splat(0.7), 50.0),
+        Bsdf::conductor(Metal::Gold, 0.3, 0.3),
+        Bsdf::conductor(Metal::Silver, 0.05, 0.4),
     ];
     let wo = Vec3::new(0.3, 0.1, 0.9).normalize();
     let mut s = Sampler::new(1, 1, 1);
@@ -177,4 +180,64 @@ fn nothing_is_reflected_from_behind() {
     assert!(phong.eval_pdf(front, front, Vec3::Z).1 > 0.0);
     assert_eq!(phong.eval_pdf(front, behind, Vec3::Z), (Rgb::ZERO, 0.0));
     assert_eq!(phong.eval_pdf(behind, front, Vec3::Z), (Rgb::ZERO, 0.0));
+}
+
+/// A rough metal's f is the same both ways (f(wo, wi) = f(wi, wo)), on
+/// any normal; its pdf is not, and needs not be.
+#[test]
+fn a_rough_metal_is_reciprocal() {
+    let mut s = Sampler::new(4, 4, 4);
+    for metal in [Bsdf::conductor(Metal::Copper, 0.2, 0.2), Bsdf::conductor(Metal::Aluminium, 0.6, 0.1)] {
+        let mut seen = 0;
+        for _ in 0..5000 {
+            let n = uniform_sphere(s.next_2d());
+            let (wo, wi) = (uniform_sphere(s.next_2d()), uniform_sphere(s.next_2d()));
+            let (wo, wi) = (if wo.dot(n) < 0.0 { -wo } else { wo }, if wi.dot(n) < 0.0 { -wi } else { wi });
+            let (there, back) = (metal.eval(wo, wi, n), metal.eval(wi, wo, n));
+            assert!((there - back).abs().max_element() <= 1e-4 * there.max_element(), "{there} and {back}");
+            seen += (there.max_element() > 0.0) as usize;
+        }
+        assert!(seen > 4900, "{metal:?}: only {seen} pairs reflect");
+    }
+}
+
+/// The visible normals' reflection is a density over directions above the
+/// surface, less what it sends below: its pdf integrates to at most 1, and
+/// to 1/(1 + α²) or more at normal incidence (the facets within 45° of
+/// the normal; `tests/bsdf_statistics.rs` says why).
+#[test]
+fn a_rough_metals_pdf_integrates_to_at_most_one() {
+    for (alpha_u, alpha_v) in [(0.2f32, 0.2f32), (0.5, 0.5), (1.0, 1.0), (0.3, 0.8)] {
+        let metal = Bsdf::conductor(Metal::Gold, alpha_u, alpha_v);
+        for wo in [Vec3::Z, Vec3::new(0.6, 0.0, 0.8), Vec3::new(0.0, 0.96, 0.28)] {
+            let total = over_the_hemisphere(|wi| metal.pdf(wo, wi, Vec3::Z) as f64);
+            assert!(total <= 1.0 + 1e-3, "α {alpha_u}, {alpha_v}, wo {wo}: {total}");
+            let above = 1.0 / (1.0 + (alpha_u.max(alpha_v) as f64).powi(2));
+            assert!(wo != Vec3::Z || total >= above - 1e-3, "α {alpha_u}, {alpha_v}: {total} below {above}");
+        }
+    }
+}
+
+/// Below `SMOOTH_ALPHA` on both axes a metal is polished: a delta mirror
+/// whose weight is Fresnel's reflectance at that angle; the scene says so
+/// too (`MaterialModel::is_specular`, what the reference picks its method by).
+#[test]
+fn a_polished_metal_is_a_mirror_of_fresnels_colour() {
+    let wo = Vec3::new(0.6, 0.0, 0.8);
+    let mut s = Sampler::new(6, 6, 6);
+    for (alpha_u, alpha_v, delta) in [(0.0f32, 0.0f32, true), (5e-4, 9e-4, true), (0.0, 0.01, false), (0.2, 0.2, false)]
+    {
+        let bsdf = Bsdf::conductor(Metal::Gold, alpha_u, alpha_v);
+        let model = MaterialModel::Conductor { metal: Metal::Gold, alpha_u, alpha_v };
+        assert_eq!((bsdf.is_specular(), model.is_specular()), (delta, delta), "α {alpha_u}, {alpha_v}");
+        if delta {
+            let sample = bsdf.sample(wo, Vec3::Z, &mut s, Transport::Radiance).expect("a mirror reflects");
+            let (eta, k) = Metal::Gold.index();
+            let fresnel: Rgb = fresnel_conductor_of(0.8f32, eta.into(), k.into()).into();
+            assert_eq!((sample.wi, sample.weight, sample.delta), (reflect(wo, Vec3::Z), fresnel, true));
+        }
+    }
+    for model in [MaterialModel::Lambert { albedo: Vec3::ONE }, MaterialModel::Mirror { tint: Vec3::ONE }] {
+        assert_eq!(model.is_specular(), Bsdf::new(&model).is_specular(), "{model:?}");
+    }
 }
