@@ -10,7 +10,9 @@ use std::sync::Arc;
 
 use gi_studio::render::{render_blocking, Algorithm, LinearImage, RenderJob, RenderSettings};
 use gi_studio::scene::mesh::{load_mesh, MeshError};
-use gi_studio::scene::{load_scene, to_ron, Object, Problem, SceneFileError, Shape, ValidScene};
+use gi_studio::scene::{
+    load_scene, parse_scene_with, save_scene, to_ron, Object, Problem, SceneFileError, Shape, ValidScene,
+};
 use glam::Vec3;
 
 /// A unit cube's corners and its six faces as quads, wound outward.
@@ -194,4 +196,32 @@ fn a_missing_or_emissive_mesh_is_refused_naming_the_line() {
     scene.meshes = Default::default();
     let problems = ValidScene::new(scene).expect_err("a mesh not loaded");
     assert!(problems.iter().any(|p| matches!(p.problem, Problem::MeshNotLoaded(_))), "{problems:?}");
+}
+
+/// A scene with a mesh beside it, saved elsewhere, opens there: the mesh
+/// is named by its full path when it is not inside the new folder, and
+/// relative to the folder when it is (so the folder can move as a whole).
+/// Its autosave text names the mesh by its full path: read back from any
+/// folder, without the meshes in memory, it finds the file.
+#[test]
+fn a_scene_saved_in_another_folder_still_finds_its_mesh() {
+    let (dir, other) = (tempfile::tempdir().expect("a folder"), tempfile::tempdir().expect("another"));
+    write(dir.path(), "cube.obj", cube_obj());
+    let (path, _) = cube_scenes(dir.path(), "cube.obj");
+    let scene = load_scene(&path).expect("the scene beside its mesh").into_scene();
+    let moved = other.path().join("moved.ron");
+    save_scene(&scene, &moved).expect("saved elsewhere");
+    let reopened = load_scene(&moved).expect("the moved scene finds its mesh").into_scene();
+    assert_eq!(reopened.objects, scene.objects, "the same objects, the mesh by the same full path");
+    assert!(std::fs::read_to_string(&moved).unwrap().contains(&dir.path().join("cube.obj").display().to_string()));
+
+    // Saved back beside the mesh: the name is relative again
+    save_scene(&reopened, &path).expect("saved beside the mesh");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("file: \"cube.obj\""), "{text}");
+    assert_eq!(load_scene(&path).expect("and it opens").into_scene().objects, scene.objects);
+
+    let autosave = to_ron(&scene).expect("RON");
+    let restored = parse_scene_with(&autosave, Path::new("autosave.ron"), &Default::default());
+    assert_eq!(restored.expect("the autosave finds its mesh").into_scene().objects, scene.objects);
 }

@@ -70,23 +70,30 @@ pub fn parse_scene_with(text: &str, path: &Path, loaded: &Meshes) -> Result<Vali
 
 /// Read each mesh file the scene's objects name, once, from beside `path`
 /// (or take it from `loaded`), within `limits::MESH_TRIANGLES` all told.
+/// Once read, a mesh is named by its full path: the scene can be saved in
+/// any folder, and its autosave restored from anywhere (`save_scene`
+/// writes the name relative again where it can).
 fn load_meshes(scene: &mut Scene, text: &str, path: &Path, loaded: &Meshes) -> Result<(), SceneFileError> {
-    let folder = path.parent().unwrap_or(Path::new(""));
-    for (index, object) in scene.objects.iter().enumerate() {
-        let Shape::Mesh { file, .. } = &object.shape else { continue };
-        if scene.meshes.get(file).is_some() {
+    let folder = folder_of(path);
+    for index in 0..scene.objects.len() {
+        let Shape::Mesh { file, .. } = &mut scene.objects[index].shape else { continue };
+        if let Some(full) = folder.join(&*file).to_str() {
+            *file = full.to_owned();
+        }
+        let file = file.clone();
+        if scene.meshes.get(&file).is_some() {
             continue;
         }
-        let mesh = match loaded.get(file) {
+        let mesh = match loaded.get(&file) {
             Some(mesh) => Ok(mesh.clone()),
-            None => load_mesh(&folder.join(file)).map(Arc::new),
+            None => load_mesh(&folder.join(&file)).map(Arc::new),
         };
         let mesh = mesh.and_then(|mesh| match scene.meshes.triangles() + mesh.triangles.len() {
-            count if count > limits::MESH_TRIANGLES => Err(MeshError::TooMany { path: folder.join(file), count }),
+            count if count > limits::MESH_TRIANGLES => Err(MeshError::TooMany { path: folder.join(&file), count }),
             _ => Ok(mesh),
         });
         match mesh {
-            Ok(mesh) => scene.meshes.insert(file.clone(), mesh),
+            Ok(mesh) => scene.meshes.insert(file, mesh),
             Err(error) => {
                 let (line, column) = locate(text, "objects", Some(index), "file");
                 return Err(SceneFileError::Mesh { path: path.to_owned(), line, column, error: Box::new(error) });
@@ -102,9 +109,26 @@ pub fn to_ron(scene: &Scene) -> Result<String, SceneFileError> {
 }
 
 /// Write the scene atomically: a failed save leaves the old file whole.
+/// A mesh inside the file's folder is named relative to it, so the folder
+/// can move as a whole; any other by its full path.
 pub fn save_scene(scene: &Scene, path: &Path) -> Result<(), SceneFileError> {
-    let text = to_ron(scene)? + "\n";
+    let folder = folder_of(path);
+    let mut written = scene.clone();
+    for object in &mut written.objects {
+        let Shape::Mesh { file, .. } = &mut object.shape else { continue };
+        let full = folder.join(&*file);
+        if let Some(inside) = full.strip_prefix(&folder).ok().and_then(Path::to_str) {
+            *file = inside.to_owned();
+        }
+    }
+    let text = to_ron(&written)? + "\n";
     Ok(fileio::write_bytes(path, text.as_bytes())?)
+}
+
+/// The full path of the folder `path` is in.
+fn folder_of(path: &Path) -> PathBuf {
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::path::absolute(folder).unwrap_or_else(|_| folder.to_owned())
 }
 
 /// Where an invalid value sits in the text: the section, then its list's
