@@ -10,6 +10,7 @@ use gi_studio::render::world::camera::TileRect;
 use gi_studio::render::world::lane_world::LaneWorld;
 use gi_studio::render::world::rng::PassStreams;
 use gi_studio::render::world::World;
+use gi_studio::scene::mesh::load_mesh;
 use gi_studio::scene::{
     presets, Attenuation, Light, LightKind, MaterialModel, Metal, Object, Rgb, Scene, Shape, ValidScene,
 };
@@ -253,6 +254,25 @@ fn triangles_found_through_the_hierarchy_bit_for_bit() {
     let scene = cornell_of_facets();
     let (world, _) = world(&scene, 40, 30);
     assert!(world.shapes.triangles.len() > gi_studio::render::world::shapes::GROUPED_TRIANGLES);
+    let lit = assert_lanes_match_scalar(&scene, 32, 2);
+    assert!(lit > 1500, "only {lit} samples carried light");
+}
+
+/// A glowing cube read from a file: a mesh light, which the lanes leave to
+/// the scalar code lane by lane, bit for bit, beside the panel they draw.
+#[test]
+fn a_mesh_light_bit_for_bit() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let file = dir.path().join("cube.obj");
+    let corners = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
+    let faces = "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 3 4 8 7\nf 2 3 7 6\nf 1 5 8 4\n";
+    std::fs::write(&file, format!("{corners}{faces}")).expect("the cube's file");
+    let mut scene = preset("cornell");
+    let key = file.display().to_string();
+    scene.meshes.insert(key.clone(), std::sync::Arc::new(load_mesh(&file).expect("the cube")));
+    let (translate, rotate_degrees) = (Vec3::new(-0.3, 0.3, 0.2), Vec3::new(0.0, 25.0, 0.0));
+    let shape = Shape::Mesh { file: key, translate, scale: 0.3, rotate_degrees };
+    scene.objects.push(Object { name: "glowing cube".into(), shape, material: "panel".into() });
     let lit = assert_lanes_match_scalar(&scene, 32, 2);
     assert!(lit > 1500, "only {lit} samples carried light");
 }

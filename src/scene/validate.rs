@@ -53,8 +53,6 @@ pub enum Problem {
     EmptyName,
     #[error("the mesh file \"{0}\" is not loaded (open the scene from its file, beside the mesh)")]
     MeshNotLoaded(String),
-    #[error("a mesh cannot be an emissive light yet: make its material not Emissive, or build the light of triangles")]
-    EmissiveMesh,
     #[error("{width} × {height} is more than the {} pixels an image may have", limits::IMAGE_PIXELS)]
     TooManyPixels { width: u32, height: u32 },
 }
@@ -256,10 +254,6 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
                 check.vector("translate", *translate);
                 check.positive("scale", *scale);
                 check.vector("rotate_degrees", *rotate_degrees);
-                let material = scene.material_index(&object.material).map(|m| &scene.materials[m].model);
-                if matches!(material, Some(MaterialModel::Emissive { .. })) {
-                    check.report("file", Problem::EmissiveMesh);
-                }
             }
         }
     }

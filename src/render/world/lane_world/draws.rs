@@ -211,6 +211,7 @@ struct Columns {
     t_max: [f32; LANES],
     point: [[f32; LANES]; 3],
     normal: [[f32; LANES]; 3],
+    on_triangle: [Option<u32>; LANES],
 }
 
 impl Columns {
@@ -225,6 +226,7 @@ impl Columns {
             t_max: light.t_max.to_array(),
             point: columns_of(light.point),
             normal: columns_of(light.light_normal),
+            on_triangle: light.on_triangle,
         }
     }
 
@@ -238,7 +240,7 @@ impl Columns {
                 (Some(triangle), None)
             }
             LightSource::Area(light::AreaLight { emitter: Emitter::Sphere { sphere, .. }, .. }) => (None, Some(sphere)),
-            _ => (None, None),
+            _ => (self.on_triangle[i], None),
         };
         let wi = lane_of(&self.wi, i);
         Some(LightSample {

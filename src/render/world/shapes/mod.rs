@@ -4,9 +4,11 @@
 //! - `sphere`: spheres four to a SIMD group, and a sphere light's cap;
 //! - `plane`: infinite planes (found by rays, never sampled);
 //! - `triangle`: triangles four to a SIMD group behind a test of where the
-//!   ray crosses their plane.
+//!   ray crosses their plane;
+//! - `mesh_light`: a mesh's triangles as one light.
 
 pub mod bvh;
+pub mod mesh_light;
 pub mod plane;
 pub mod sphere;
 pub mod triangle;
@@ -20,6 +22,7 @@ use crate::geometry::{Ray, SurfaceHit, Triangle};
 use crate::scene::mesh::Meshes;
 use crate::scene::Shape;
 use bvh::Bvh;
+pub use mesh_light::MeshEmitter;
 pub use plane::PlaneShape;
 use sphere::Sphere;
 pub use sphere::{CappedSphere, EmitterCap, SphereLanes, SphereReach, Spheres};
@@ -54,12 +57,28 @@ pub trait AreaEmitter {
 
 /// The surface an area light is sampled on: the shape, with what each
 /// kind answers as a light in its own file (`AreaEmitter`).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum Emitter {
     /// Sphere `sphere` of the world, emitting from its cap.
     Sphere { sphere: u32, shape: CappedSphere },
     /// Triangle `triangle` of the world.
     Triangle { triangle: u32, shape: Triangle },
+    /// A mesh's triangles (shared: the light is cloned with the world's lights).
+    Mesh(Arc<MeshEmitter>),
+}
+
+/// A point drawn on an emitter as seen from a point.
+#[derive(Clone, Copy, Debug)]
+pub struct EmitterSample {
+    pub point: Vec3,
+    /// The emitter's outward normal there.
+    pub normal: Vec3,
+    /// Bound on the point's error.
+    pub error: f32,
+    /// Solid-angle pdf at the point it was seen from.
+    pub pdf: f32,
+    /// The world's triangle it lies on, if it lies on one.
+    pub triangle: Option<u32>,
 }
 
 /// `$body` for the emitter's shape, whatever its kind.
@@ -68,6 +87,7 @@ macro_rules! on_shape {
         match $emitter {
             Emitter::Sphere { shape: $shape, .. } => $body,
             Emitter::Triangle { shape: $shape, .. } => $body,
+            Emitter::Mesh($shape) => $body,
         }
     };
 }
@@ -96,12 +116,21 @@ impl Emitter {
         (point, normal, self.error())
     }
 
-    /// A point on it seen from `p`: (point, outward normal, error bound,
-    /// solid-angle pdf at `p`).
+    /// A point on it seen from `p`.
     #[inline]
-    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32, f32)> {
-        let (point, normal, pdf) = on_shape!(self, shape => shape.sample_from(p, u))?;
-        Some((point, normal, self.error(), pdf))
+    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<EmitterSample> {
+        let (point, normal, pdf, triangle) = match self {
+            Emitter::Sphere { shape, .. } => shape.sample_from(p, u).map(|(a, b, c)| (a, b, c, None))?,
+            Emitter::Triangle { triangle, shape } => {
+                shape.sample_from(p, u).map(|(a, b, c)| (a, b, c, Some(*triangle)))?
+            }
+            Emitter::Mesh(mesh) => {
+                let (k, point, normal) = mesh.uniform_triangle_point(u);
+                let pdf = solid_angle_pdf(p, point, normal, mesh.area());
+                (pdf > 0.0).then_some((point, normal, pdf, Some(mesh.first + k as u32)))?
+            }
+        };
+        Some(EmitterSample { point, normal, error: self.error(), pdf, triangle })
     }
 
     /// The solid-angle pdf with which `sample_from` draws `hit` from `p`.
@@ -236,7 +265,12 @@ impl Shapes {
                 let triangle = self.triangles[t as usize].0;
                 (!triangle.is_degenerate()).then_some(Emitter::Triangle { triangle: t, shape: triangle })
             }
-            ShapeRef::Plane(_) | ShapeRef::Mesh { .. } => None,
+            ShapeRef::Mesh { first, count } => {
+                let triangles: Vec<Triangle> =
+                    self.triangles[first as usize..(first + count) as usize].iter().map(|(t, _)| *t).collect();
+                MeshEmitter::new(first, &triangles).map(|mesh| Emitter::Mesh(Arc::new(mesh)))
+            }
+            ShapeRef::Plane(_) => None,
         }
     }
 
