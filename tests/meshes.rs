@@ -292,10 +292,11 @@ fn an_emissive_mesh_lights_the_scene_in_every_algorithm() {
     }
 }
 
-/// Shadow rays toward a mesh light skip the triangle their sample lies on
-/// and nothing else: under a glowing cube screened by a triangle, every
-/// light sample from the floor below is blocked, by the scalar occluders
-/// and by the lanes' shadow test alike; without the screen none is.
+/// Shadow rays toward a mesh light skip nothing (they stop short of their
+/// point): under a glowing cube screened by a triangle, every light sample
+/// from the floor below is blocked, by the scalar occluders and by the
+/// lanes' shadow test alike; without the screen none is, not even by the
+/// cube's own triangle the sample lies on.
 #[test]
 fn a_screen_blocks_a_mesh_light() {
     use gi_studio::geometry::SurfaceHit;

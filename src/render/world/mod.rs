@@ -186,17 +186,6 @@ impl World {
                 light_triangles.iter().copied().find(holds).unwrap_or(u32::MAX)
             })
             .collect();
-        // A mesh light's triangles outside those planes are each their own:
-        // a shadow ray toward a point on one skips that one only
-        for light in &world.lights {
-            if let LightSource::Area(light::AreaLight { emitter: Emitter::Mesh(mesh), .. }) = light {
-                for t in mesh.first..mesh.first + mesh.count() {
-                    if world.light_plane[t as usize] == u32::MAX {
-                        world.light_plane[t as usize] = t;
-                    }
-                }
-            }
-        }
         world.fit_caps(None);
         world
     }

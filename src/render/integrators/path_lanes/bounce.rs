@@ -183,16 +183,11 @@ fn bounce_live(lane_world: &LaneWorld, world: &World, st: &mut Lanes, max_depth:
         let shade = light.valid.and(above).and(f.nonzero());
         counters.rays += shade.count();
         if shade.any() {
-            let drawn_here = light.on_triangle != [None; LANES];
-            let skips = if light_count == 1 && !drawn_here {
+            let skips = if light_count == 1 {
                 Skips::All { sphere: lane_world.light_spheres[0], plane: lane_world.light_planes[0] }
             } else {
                 let spheres = lanes::each(|i| lane_world.light_spheres[pick[i]]);
-                let plane = |i: usize| match light.on_triangle[i] {
-                    Some(triangle) => Some(lane_world.triangle_plane(triangle)),
-                    None => lane_world.light_planes[pick[i]],
-                };
-                Skips::Lanes { spheres, planes: lanes::each(plane) }
+                Skips::Lanes { spheres, planes: lanes::each(|i| lane_world.light_planes[pick[i]]) }
             };
             let blocked = lane_world.blocked(shade, st.inside_walls, light.origin, light.wi, light.t_max, &skips);
             let lit = shade.and_not(blocked);

@@ -211,7 +211,6 @@ struct Columns {
     t_max: [f32; LANES],
     point: [[f32; LANES]; 3],
     normal: [[f32; LANES]; 3],
-    on_triangle: [Option<u32>; LANES],
 }
 
 impl Columns {
@@ -226,7 +225,6 @@ impl Columns {
             t_max: light.t_max.to_array(),
             point: columns_of(light.point),
             normal: columns_of(light.light_normal),
-            on_triangle: light.on_triangle,
         }
     }
 
@@ -240,7 +238,7 @@ impl Columns {
                 (Some(triangle), None)
             }
             LightSource::Area(light::AreaLight { emitter: Emitter::Sphere { sphere, .. }, .. }) => (None, Some(sphere)),
-            _ => (self.on_triangle[i], None),
+            _ => (None, None),
         };
         let wi = lane_of(&self.wi, i);
         Some(LightSample {

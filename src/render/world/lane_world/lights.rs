@@ -120,7 +120,6 @@ impl LaneLight {
                 error,
                 radiance,
             }),
-            // Drawn lane by lane by the scalar code, as the background is
             Emitter::Mesh(_) => return None,
         })
     }
@@ -380,9 +379,6 @@ pub(crate) struct LightLanes {
     /// and `normal`): what bidirectional methods weigh a sample by.
     pub(crate) point: V8,
     pub(crate) light_normal: V8,
-    /// The triangle of the world each sample drawn lane by lane lies on
-    /// (the lanes' own lights say theirs through `LaneWorld::light_planes`).
-    pub(crate) on_triangle: [Option<u32>; LANES],
 }
 
 impl LightLanes {
@@ -428,7 +424,6 @@ impl LightLanes {
             t_max: F8::splat(0.0),
             point: V8::splat(Vec3::ZERO),
             light_normal: V8::splat(Vec3::ZERO),
-            on_triangle: [None; LANES],
         };
         let (mut drawn, mut in_lanes) = (None, M8::NONE);
         if let Some(on_light) = ahead {
@@ -455,19 +450,7 @@ impl LightLanes {
             let faces = !light_normal.dot(-wi).le(F8::splat(0.0));
             let valid = in_lanes.and(pdf.gt(F8::splat(0.0))).and(faces);
             let value = radiance / pdf;
-            let on_triangle = out.on_triangle;
-            out = LightLanes {
-                valid,
-                delta: M8::NONE,
-                wi,
-                value,
-                pdf,
-                origin,
-                t_max,
-                point: target,
-                light_normal,
-                on_triangle,
-            };
+            out = LightLanes { valid, delta: M8::NONE, wi, value, pdf, origin, t_max, point: target, light_normal };
         }
         if let Some((lanes, points)) = lights.of_kind(pick, mask, 3, LaneLight::point) {
             let position = points.v8(|light| light.position);
@@ -507,7 +490,6 @@ impl LightLanes {
                 out.t_max.set_lane(lane, sample.shadow_t_max);
                 out.point.set_lane(lane, sample.point);
                 out.light_normal.set_lane(lane, sample.normal);
-                out.on_triangle[lane] = sample.on_triangle;
             }
         }
         out

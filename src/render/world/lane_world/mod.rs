@@ -252,12 +252,6 @@ impl LaneWorld {
 
     /// Whether `radiance` traces eight lanes at once on this CPU (AVX2 on
     /// x86-64), rather than falling back to the scalar tracer.
-    /// The light plane of triangle `triangle` (`World::light_plane`).
-    #[inline]
-    pub(crate) fn triangle_plane(&self, triangle: u32) -> u32 {
-        self.triangle_planes[triangle as usize]
-    }
-
     pub fn runs_in_lanes() -> bool {
         lanes::supported()
     }

@@ -200,8 +200,6 @@ pub(crate) struct LaneSurfaces<'a> {
     /// The glossy lanes' lobes (zeros where no lane is glossy).
     phong_lobe: Phong<F8>,
     blinn_phong_lobe: BlinnPhong<F8>,
-    /// The rough metals' lobes (a dummy where no lane is a rough metal).
-    rough_conductor_lobe: RoughConductor<F8>,
 }
 
 impl<'a> LaneSurfaces<'a> {
@@ -225,32 +223,19 @@ impl<'a> LaneSurfaces<'a> {
             ),
             false => (V8::splat(Vec3::ZERO), F8::splat(0.0), F8::splat(0.0), F8::splat(0.0)),
         };
-        let rough_conductor = kind(ROUGH_CONDUCTOR);
-        let rough_conductor_lobe = match rough_conductor.any() {
-            true => RoughConductor {
-                eta: table.eta.get(index),
-                k: table.k.get(index),
-                ggx: Ggx { alpha_x: table.alpha_x.get(index), alpha_y: table.alpha_y.get(index) },
-            },
-            false => RoughConductor {
-                eta: V8::splat(Vec3::ONE),
-                k: V8::splat(Vec3::ZERO),
-                ggx: Ggx { alpha_x: F8::splat(1.0), alpha_y: F8::splat(1.0) },
-            },
-        };
+
         LaneSurfaces {
             lambert: kind(LAMBERT),
             phong,
             blinn_phong,
             mirror: kind(MIRROR),
             glass: kind(GLASS),
-            rough_conductor,
+            rough_conductor: kind(ROUGH_CONDUCTOR),
             smooth_conductor: kind(SMOOTH_CONDUCTOR),
             emissive: kind(EMITTER),
             color,
             phong_lobe: Phong { kd: color, ks, exponent, diffuse_probability },
             blinn_phong_lobe: BlinnPhong { kd: color, ks, exponent, diffuse_probability, normalisation },
-            rough_conductor_lobe,
             table,
             index,
         }
@@ -267,6 +252,14 @@ impl<'a> LaneSurfaces<'a> {
         self.rough_conductor = self.rough_conductor.and(lanes);
         self.smooth_conductor = self.smooth_conductor.and(lanes);
         self.emissive = self.emissive.and(lanes);
+    }
+
+    /// The rough metals' lobes, gathered when some lane holds one.
+    #[inline(always)]
+    fn rough_conductor(&self) -> RoughConductor<F8> {
+        let (table, index) = (self.table, self.index);
+        let ggx = Ggx { alpha_x: table.alpha_x.get(index), alpha_y: table.alpha_y.get(index) };
+        RoughConductor { eta: table.eta.get(index), k: table.k.get(index), ggx }
     }
 
     /// `Bsdf::is_specular`: mirrors, glass, polished metals, and what
@@ -300,7 +293,7 @@ impl<'a> LaneSurfaces<'a> {
         }
         let rough_conductor = self.rough_conductor.and(wanted);
         if rough_conductor.any() {
-            let (metal_f, metal_pdf) = self.rough_conductor_lobe.eval_pdf(wo, wi, n);
+            let (metal_f, metal_pdf) = self.rough_conductor().eval_pdf(wo, wi, n);
             (f, pdf) = (rough_conductor.select_v(metal_f, f), rough_conductor.select(metal_pdf, pdf));
         }
         (f, pdf)
@@ -334,7 +327,7 @@ impl<'a> LaneSurfaces<'a> {
             out.take(self.glass, glass.sample(self.glass, &at, rng, transport));
         }
         if self.rough_conductor.any() {
-            let sampled = self.rough_conductor_lobe.sample(self.rough_conductor, &at, rng, transport);
+            let sampled = self.rough_conductor().sample(self.rough_conductor, &at, rng, transport);
             out.take(self.rough_conductor, sampled);
         }
         if self.smooth_conductor.any() {

@@ -11,8 +11,6 @@ use crate::render::world::alias::AliasTable;
 
 #[derive(Clone, Debug)]
 pub struct MeshEmitter {
-    /// The world's index of the first of its triangles, which follow it.
-    pub first: u32,
     /// Its triangles, degenerate ones with no chance of being drawn.
     triangles: Vec<Triangle>,
     by_area: AliasTable,
@@ -22,28 +20,14 @@ pub struct MeshEmitter {
 }
 
 impl MeshEmitter {
-    /// The triangles from the world's `first` on; `None` when they have no area.
-    pub fn new(first: u32, triangles: &[Triangle]) -> Option<Self> {
+    /// Of `triangles`; `None` when they have no area.
+    pub fn new(triangles: &[Triangle]) -> Option<Self> {
         let areas: Vec<f64> =
             triangles.iter().map(|t| if t.is_degenerate() { 0.0 } else { Triangle::area(t) as f64 }).collect();
         let by_area = AliasTable::new(&areas)?;
         let area = areas.iter().sum::<f64>() as f32;
         let error = triangles.iter().map(AreaEmitter::error).fold(0.0, f32::max);
-        Some(Self { first, triangles: triangles.to_vec(), by_area, area, error })
-    }
-
-    /// How many triangles it has.
-    pub fn count(&self) -> u32 {
-        self.triangles.len() as u32
-    }
-
-    /// A triangle by area and a point uniform on it: (the triangle's index
-    /// among the mesh's, point, normal).
-    #[inline]
-    pub fn uniform_triangle_point(&self, u: Vec2) -> (usize, Vec3, Vec3) {
-        let (k, u0) = self.by_area.sample(u.x);
-        let (point, normal) = self.triangles[k].uniform_point(Vec2::new(u0, u.y));
-        (k, point, normal)
+        Some(Self { triangles: triangles.to_vec(), by_area, area, error })
     }
 }
 
@@ -60,9 +44,10 @@ impl AreaEmitter for MeshEmitter {
         self.error
     }
 
+    /// A triangle by area, then a point uniform on it.
     fn uniform_point(&self, u: Vec2) -> (Vec3, Vec3) {
-        let (_, point, normal) = self.uniform_triangle_point(u);
-        (point, normal)
+        let (k, u0) = self.by_area.sample(u.x);
+        self.triangles[k].uniform_point(Vec2::new(u0, u.y))
     }
 
     fn sample_from(&self, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32)> {

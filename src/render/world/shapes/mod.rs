@@ -77,7 +77,7 @@ pub struct EmitterSample {
     pub error: f32,
     /// Solid-angle pdf at the point it was seen from.
     pub pdf: f32,
-    /// The world's triangle it lies on, if it lies on one.
+    /// The world's triangle whose light plane a shadow ray toward it skips.
     pub triangle: Option<u32>,
 }
 
@@ -119,16 +119,14 @@ impl Emitter {
     /// A point on it seen from `p`.
     #[inline]
     pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<EmitterSample> {
-        let (point, normal, pdf, triangle) = match self {
-            Emitter::Sphere { shape, .. } => shape.sample_from(p, u).map(|(a, b, c)| (a, b, c, None))?,
-            Emitter::Triangle { triangle, shape } => {
-                shape.sample_from(p, u).map(|(a, b, c)| (a, b, c, Some(*triangle)))?
-            }
-            Emitter::Mesh(mesh) => {
-                let (k, point, normal) = mesh.uniform_triangle_point(u);
-                let pdf = solid_angle_pdf(p, point, normal, mesh.area());
-                (pdf > 0.0).then_some((point, normal, pdf, Some(mesh.first + k as u32)))?
-            }
+        let (point, normal, pdf) = on_shape!(self, shape => shape.sample_from(p, u))?;
+        // A shadow ray toward a lone triangle skips its plane (the seam of a
+        // panel in a ceiling); toward a mesh nothing: it stops short of the
+        // point by the error margin (`ray_to`), and the mesh's other
+        // triangles may block it
+        let triangle = match self {
+            Emitter::Triangle { triangle, .. } => Some(*triangle),
+            _ => None,
         };
         Some(EmitterSample { point, normal, error: self.error(), pdf, triangle })
     }
@@ -268,7 +266,7 @@ impl Shapes {
             ShapeRef::Mesh { first, count } => {
                 let triangles: Vec<Triangle> =
                     self.triangles[first as usize..(first + count) as usize].iter().map(|(t, _)| *t).collect();
-                MeshEmitter::new(first, &triangles).map(|mesh| Emitter::Mesh(Arc::new(mesh)))
+                MeshEmitter::new(&triangles).map(|mesh| Emitter::Mesh(Arc::new(mesh)))
             }
             ShapeRef::Plane(_) => None,
         }
