@@ -10,7 +10,7 @@ use crate::faults::{self, Fault};
 use crate::geometry::{offset_ray_origin, Frame, Ray, SurfaceHit};
 use crate::render::world::emission::{Bounds, Emission};
 use crate::render::world::sampling::cosine_hemisphere;
-use crate::render::world::shapes::{Emitter, EmitterSample};
+use crate::render::world::shapes::Emitter;
 use crate::scene::Rgb;
 
 #[derive(Clone, Debug)]
@@ -27,16 +27,20 @@ impl Light for AreaLight {
 
     #[inline]
     fn sample(&self, at: &SurfaceHit, u: Vec2) -> Option<LightSample> {
-        let EmitterSample { point: target, normal, error, pdf, triangle: on_triangle } =
-            self.emitter.sample_from(at.point, u)?;
+        let (target, normal, error, pdf) = self.emitter.sample_from(at.point, u)?;
         let (shadow, shadow_t_max) = at.spawn_ray_to(target, error);
         // Emission is one-sided: the light's front must face the point
         if normal.dot(-shadow.direction) <= 0.0 || pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
-        let on_sphere = match self.emitter {
-            Emitter::Sphere { sphere, .. } => Some(sphere),
-            _ => None,
+        // A shadow ray toward a lone triangle skips its plane (the seam of a
+        // panel in a ceiling); toward a mesh nothing: it stops short of the
+        // point by the error margin (`ray_to`), and the mesh's other
+        // triangles may rightly block it
+        let (on_triangle, on_sphere) = match self.emitter {
+            Emitter::Triangle { triangle, .. } => (Some(triangle), None),
+            Emitter::Sphere { sphere, .. } => (None, Some(sphere)),
+            Emitter::Mesh(_) => (None, None),
         };
         Some(LightSample {
             wi: shadow.direction,

@@ -67,20 +67,6 @@ pub enum Emitter {
     Mesh(Arc<MeshEmitter>),
 }
 
-/// A point drawn on an emitter as seen from a point.
-#[derive(Clone, Copy, Debug)]
-pub struct EmitterSample {
-    pub point: Vec3,
-    /// The emitter's outward normal there.
-    pub normal: Vec3,
-    /// Bound on the point's error.
-    pub error: f32,
-    /// Solid-angle pdf at the point it was seen from.
-    pub pdf: f32,
-    /// The world's triangle whose light plane a shadow ray toward it skips.
-    pub triangle: Option<u32>,
-}
-
 /// `$body` for the emitter's shape, whatever its kind.
 macro_rules! on_shape {
     ($emitter:expr, $shape:ident => $body:expr) => {
@@ -116,19 +102,12 @@ impl Emitter {
         (point, normal, self.error())
     }
 
-    /// A point on it seen from `p`.
+    /// A point on it seen from `p`: (point, outward normal, error bound,
+    /// solid-angle pdf at `p`).
     #[inline]
-    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<EmitterSample> {
+    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<(Vec3, Vec3, f32, f32)> {
         let (point, normal, pdf) = on_shape!(self, shape => shape.sample_from(p, u))?;
-        // A shadow ray toward a lone triangle skips its plane (the seam of a
-        // panel in a ceiling); toward a mesh nothing: it stops short of the
-        // point by the error margin (`ray_to`), and the mesh's other
-        // triangles may block it
-        let triangle = match self {
-            Emitter::Triangle { triangle, .. } => Some(*triangle),
-            _ => None,
-        };
-        Some(EmitterSample { point, normal, error: self.error(), pdf, triangle })
+        Some((point, normal, self.error(), pdf))
     }
 
     /// The solid-angle pdf with which `sample_from` draws `hit` from `p`.
