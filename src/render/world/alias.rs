@@ -45,14 +45,6 @@ impl AliasTable {
         Some(Self { columns, probabilities })
     }
 
-    pub fn len(&self) -> usize {
-        self.columns.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.columns.is_empty()
-    }
-
     /// The probability of drawing item `i`.
     pub fn probability(&self, i: usize) -> f32 {
         self.probabilities.get(i).copied().unwrap_or(0.0)

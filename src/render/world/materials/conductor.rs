@@ -40,7 +40,8 @@ impl<R: Real> Scatter<R> for RoughConductor<R> {
     }
 
     /// f = F(wo·h) D(h) G1(wo) G1(wi) / (4 cos θo cos θi), and the density
-    /// of the visible normals' reflection.
+    /// of the visible normals' reflection, D_wo(h) / (4 wo·h) =
+    /// G1(wo) D(h) / (4 cos θo).
     #[inline(always)]
     fn eval_pdf(&self, wo: V3<R>, wi: V3<R>, n: V3<R>) -> (V3<R>, R) {
         let zero = R::splat(0.0);

@@ -56,13 +56,6 @@ impl<R: Real> Ggx<R> {
         let h = V3::new(sin_theta * cos_phi, sin_theta * sin_phi, z) + stretched;
         V3::new(h.x * self.alpha_x, h.y * self.alpha_y, h.z.max(zero)).normalize()
     }
-
-    /// The solid-angle density of the reflected direction when the normal
-    /// is drawn by `sample_visible`: D_wo(h) / (4 wo·h) = G1(wo) D(h) / (4 wo.z).
-    #[inline(always)]
-    pub fn reflection_pdf(&self, wo: V3<R>, h: V3<R>) -> R {
-        self.g1(wo) * self.d(h) / (wo.z * 4.0)
-    }
 }
 
 #[cfg(test)]
