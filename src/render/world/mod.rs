@@ -43,6 +43,7 @@ enum Inside<'w> {
     /// Wall sphere `k` of `Walls::wall_spheres`, left.
     Wall(usize),
     Plane(&'w PlaneShape),
+    /// A triangle of this object.
     Triangle(u32),
 }
 
@@ -276,9 +277,9 @@ impl World {
             }
         }
         let triangle_hit = self.shapes.nearest_triangle(ray, best_t);
-        if let Some((i, hit)) = triangle_hit {
+        if let Some((_, object, hit)) = triangle_hit {
             best_t = hit.t;
-            best = Some(Inside::Triangle(i));
+            best = Some(Inside::Triangle(object));
         }
         let (surface, object) = match best? {
             Inside::Sphere(i, near) => {
@@ -293,7 +294,7 @@ impl World {
                 (surface, s.list[*i as usize].object)
             }
             Inside::Plane(plane) => (plane_hit(ray, plane.normal, plane.offset, best_t), plane.object),
-            Inside::Triangle(i) => (triangle_hit?.1, self.shapes.triangles[i as usize].1),
+            Inside::Triangle(object) => (triangle_hit?.2, object),
         };
         Some(Hit { surface, object, material: self.objects[object as usize].material })
     }

@@ -11,7 +11,6 @@ use crate::geometry::{edges_of, ray_shear_of, triangle_hit_of, watertight_finish
 use crate::geometry::{intersect_triangle, Ray, SurfaceHit, Triangle};
 use crate::geometry::{plane_exit_of, plane_point_of, plane_t_of, Crossing, CullEdges, CullPlane};
 use crate::render::world::lanes::{self, Index8, F8, LANES, M8, V8};
-use crate::render::world::shapes::triangle;
 use crate::render::world::{Hit, World};
 
 impl LaneWorld {
@@ -134,11 +133,11 @@ impl LaneWorld {
             (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
         let mut crossing = RunCrossing::new();
         // Through the hierarchy, lane by lane, where there is one
-        if let Some(bvh) = &self.triangle_bvh {
+        if let Some(tree) = &self.triangle_tree {
             for lane in active.lanes() {
                 let ray = Ray::new(origin.lane(lane), direction.lane(lane));
                 let triangle = |i: u32| &self.triangles[i as usize];
-                if let Some((j, hit)) = triangle::nearest_in(bvh, triangle, &ray, t_hit.lane(lane)) {
+                if let Some((j, _, hit)) = tree.nearest(triangle, &ray, t_hit.lane(lane)) {
                     t_hit.set_lane(lane, hit.t);
                     index.set_lane(lane, first_triangle + j as f32);
                     triangle_point.set_lane(lane, hit.point);
@@ -147,7 +146,7 @@ impl LaneWorld {
                 }
             }
         }
-        let grouped = if self.triangle_bvh.is_some() { &[][..] } else { &self.triangles[..] };
+        let grouped = if self.triangle_tree.is_some() { &[][..] } else { &self.triangles[..] };
         for (j, triangle) in grouped.iter().enumerate() {
             let (near, sure) = Self::cull(&self.triangle_culls[j], &mut crossing, active, origin, direction, t_hit);
             if sure.any() {

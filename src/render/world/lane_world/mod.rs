@@ -39,7 +39,7 @@ use crate::geometry::Triangle;
 use crate::render::world::lanes::{self, Column, Column3, Index8, F8, LANES, M8, V8};
 use crate::render::world::light::{self, Emitter, LightSource};
 pub(crate) use crate::render::world::materials::lanes::{LaneSurfaces, MaterialTable, Scattered};
-use crate::render::world::shapes::{bvh::Bvh, sphere::Sphere, ShapeIndex};
+use crate::render::world::shapes::{sphere::Sphere, ShapeIndex, TriangleTree};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::Rgb;
 
@@ -135,7 +135,7 @@ pub struct LaneWorld {
     triangle_culls: Vec<LaneCull>,
     /// The world's hierarchy over its triangles, where it has one: each
     /// lane's ray finds its triangle through it, as the scalar code does.
-    triangle_bvh: Option<Arc<Bvh>>,
+    triangle_tree: Option<Arc<TriangleTree>>,
     /// Each triangle's light plane (`World::light_plane`): a shadow ray
     /// toward a light on a triangle skips the triangles of its plane.
     triangle_planes: Vec<u32>,
@@ -235,11 +235,11 @@ impl LaneWorld {
             planes,
             triangles: world.shapes.triangles.iter().map(|(triangle, _)| *triangle).collect(),
             // A hierarchy's triangles are never culled in the lanes
-            triangle_culls: match world.shapes.triangle_bvh {
+            triangle_culls: match world.shapes.triangle_tree {
                 Some(_) => Vec::new(),
                 None => lane_culls(&world.shapes.triangles),
             },
-            triangle_bvh: world.shapes.triangle_bvh.clone(),
+            triangle_tree: world.shapes.triangle_tree.clone(),
             triangle_planes: world.light_plane.clone(),
             surfaces,
             lights: LaneLights::new(world),

@@ -8,7 +8,6 @@ use crate::geometry::sphere::nearest_root;
 use crate::geometry::Ray;
 use crate::render::world::lanes::{self, F8, LANES, M8, V8};
 use crate::render::world::occluders::Shadow;
-use crate::render::world::shapes::triangle;
 
 impl LaneWorld {
     /// Lanes whose segment (origin, unit direction, t_max) meets `sphere`.
@@ -60,7 +59,7 @@ impl LaneWorld {
         // the light triangle a ray ends on
         let mut crossing = RunCrossing::new();
         // Through the hierarchy, lane by lane, where there is one
-        if let Some(bvh) = &self.triangle_bvh {
+        if let Some(tree) = &self.triangle_tree {
             for lane in mask.and_not(blocked).lanes() {
                 let ray = Ray::new(origin.lane(lane), direction.lane(lane));
                 let skip = match skips {
@@ -69,12 +68,12 @@ impl LaneWorld {
                 };
                 let triangle = |i: u32| &self.triangles[i as usize];
                 let aimed_at = |i: u32| skip == Some(self.triangle_planes[i as usize]);
-                if triangle::any_in(bvh, triangle, &ray, t_max.lane(lane), aimed_at) {
+                if tree.any_hit(triangle, &ray, t_max.lane(lane), aimed_at) {
                     blocked.set(lane, true);
                 }
             }
         }
-        let grouped = if self.triangle_bvh.is_some() { &[][..] } else { &self.triangles[..] };
+        let grouped = if self.triangle_tree.is_some() { &[][..] } else { &self.triangles[..] };
         for (j, (triangle, plane)) in grouped.iter().zip(&self.triangle_planes).enumerate() {
             let aimed_at = match skips {
                 Skips::All { plane: skip, .. } if *skip == Some(*plane) => continue,

@@ -17,15 +17,40 @@ use crate::geometry::{gamma, Ray};
 /// Primitives a leaf holds once a split no longer pays.
 const LEAF: usize = 4;
 
-/// Bins the centroids are counted into along the split axis.
-const BINS: usize = 12;
+/// Bins the centroids are counted into along each axis.
+const BINS: usize = 16;
 
-/// How deep the build splits.
-const MAX_DEPTH: usize = 48;
+/// Below this depth the build splits at the median, not where the
+/// heuristic would (on a scene built to make it peel off one primitive a
+/// level): the halves keep the tree within `MAX_DEPTH` and every leaf at
+/// most `2 * LEAF` primitives, whatever the scene.
+const MEDIAN_DEPTH: usize = 32;
+
+/// How deep the tree can be: 32 halvings more than `MEDIAN_DEPTH` leave
+/// a leaf of any `u32` count of primitives.
+const MAX_DEPTH: usize = MEDIAN_DEPTH + 32;
 
 /// The traversal's stack: a four-wide node is at least one binary level
 /// below its parent, and each leaves at most three children waiting.
 const STACK: usize = 3 * MAX_DEPTH + 1;
+
+/// Asks the memory for the first `lines` cache lines of `what`: a hint,
+/// which changes nothing but when the lines arrive.
+#[inline(always)]
+pub fn prefetch_lines<T>(what: &T, lines: usize) {
+    #[cfg(target_arch = "x86_64")]
+    for line in 0..lines {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let at = (what as *const T as *const i8).wrapping_add(64 * line);
+        // SAFETY: SSE is part of x86-64, and a prefetch reads nothing
+        #[allow(unsafe_code)]
+        unsafe {
+            _mm_prefetch::<_MM_HINT_T0>(at)
+        };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (what, lines);
+}
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
@@ -37,8 +62,10 @@ struct Node {
     count: u32,
 }
 
-/// Four children's boxes side by side, tested against a ray at once.
+/// Four children's boxes side by side, tested against a ray at once: two
+/// cache lines.
 #[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
 struct Wide {
     /// Per axis, each child's low and high bound.
     lo: [Vec4; 3],
@@ -46,8 +73,9 @@ struct Wide {
     /// Per child: an inner node's index in `wide`, or a leaf's first
     /// primitive in `order`.
     start: [u32; 4],
-    /// Per child: a leaf's count of primitives; 0 for an inner node.
-    count: [u32; 4],
+    /// Per child: a leaf's count of primitives (at most `2 * LEAF`, or
+    /// what `map_leaves` made of it); 0 for an inner node.
+    count: [u8; 4],
     /// The children it has, a bit each.
     valid: u32,
 }
@@ -86,8 +114,16 @@ fn half_area((lo, hi): Bounds) -> f32 {
 }
 
 impl Bvh {
-    /// Over primitives with boxes `bounds` (index i for `bounds[i]`).
-    pub fn new(bounds: &[Bounds]) -> Self {
+    /// Over primitives with boxes `bounds` (index i for `bounds[i]`), which
+    /// a leaf tests `together` at a time (the heuristic weighs a leaf by
+    /// its tests).
+    pub fn new(bounds: &[Bounds], together: usize) -> Self {
+        Self::build(bounds, together, MEDIAN_DEPTH)
+    }
+
+    /// `new`, halving at the median from `median_depth` down.
+    fn build(bounds: &[Bounds], together: usize, median_depth: usize) -> Self {
+        let together = together.max(1);
         if bounds.is_empty() {
             return Bvh::default();
         }
@@ -101,8 +137,9 @@ impl Bvh {
             let (lo, hi) = range.iter().fold(EMPTY, |b, &i| union(b, bounds[i as usize]));
             bvh.nodes[node].lo = lo;
             bvh.nodes[node].hi = hi;
-            let split = match range.len() > LEAF && depth + 1 < MAX_DEPTH {
-                true => Self::split(range, bounds, &centroids, (lo, hi)),
+            let split = match range.len() > LEAF {
+                true if depth < median_depth => Self::split(range, bounds, &centroids, (lo, hi), together),
+                true => Some(Self::median(range, &centroids)),
                 false => None,
             };
             let Some(middle) = split else {
@@ -122,57 +159,71 @@ impl Bvh {
 
     /// Sorts `range` about the cheapest split by the heuristic and says
     /// where its right part starts; `None` where a leaf is cheaper.
-    fn split(range: &mut [u32], bounds: &[Bounds], centroids: &[Vec3], node: Bounds) -> Option<usize> {
+    fn split(range: &mut [u32], bounds: &[Bounds], centroids: &[Vec3], node: Bounds, together: usize) -> Option<usize> {
+        // What a leaf of n primitives costs: its tests of `together` at once
+        let tests = |n: usize| n.div_ceil(together) as f32;
         let (c_lo, c_hi) = range.iter().fold(EMPTY, |b, &i| union(b, (centroids[i as usize], centroids[i as usize])));
         let extent = c_hi - c_lo;
-        let axis = extent.max_position();
-        if extent[axis] <= 0.0 {
-            // Every centroid in one place: halve by count once too many
-            return (range.len() > 2 * LEAF).then_some(range.len() / 2);
-        }
-        let bin_of = |i: u32| {
+        let bin_of = |i: u32, axis: usize| {
             let at = (centroids[i as usize][axis] - c_lo[axis]) / extent[axis] * BINS as f32;
             (at as usize).min(BINS - 1)
         };
-        let mut bins = [(EMPTY, 0usize); BINS];
-        for &i in range.iter() {
-            let bin = &mut bins[bin_of(i)];
-            *bin = (union(bin.0, bounds[i as usize]), bin.1 + 1);
-        }
-        // The cost of each split between bins k and k + 1, from both ends
-        let mut right = [(0.0f32, 0usize); BINS];
-        let mut acc = (EMPTY, 0);
-        for k in (1..BINS).rev() {
-            acc = (union(acc.0, bins[k].0), acc.1 + bins[k].1);
-            right[k] = (half_area(acc.0), acc.1);
-        }
-        let mut left = (EMPTY, 0);
-        let mut best = (f32::INFINITY, 0);
-        for k in 0..BINS - 1 {
-            left = (union(left.0, bins[k].0), left.1 + bins[k].1);
-            let (right_area, right_count) = right[k + 1];
-            let cost = half_area(left.0) * left.1 as f32 + right_area * right_count as f32;
-            if left.1 > 0 && right_count > 0 && cost < best.0 {
-                best = (cost, k);
+        // (cost, axis, last bin to the left): the cheapest split on any axis
+        let mut best = (f32::INFINITY, 0, 0);
+        for axis in (0..3).filter(|&axis| extent[axis] > 0.0) {
+            let mut bins = [(EMPTY, 0usize); BINS];
+            for &i in range.iter() {
+                let bin = &mut bins[bin_of(i, axis)];
+                *bin = (union(bin.0, bounds[i as usize]), bin.1 + 1);
+            }
+            // The cost of each split between bins k and k + 1, from both ends
+            let mut right = [(0.0f32, 0usize); BINS];
+            let mut acc = (EMPTY, 0);
+            for k in (1..BINS).rev() {
+                acc = (union(acc.0, bins[k].0), acc.1 + bins[k].1);
+                right[k] = (half_area(acc.0), acc.1);
+            }
+            let mut left = (EMPTY, 0);
+            for k in 0..BINS - 1 {
+                left = (union(left.0, bins[k].0), left.1 + bins[k].1);
+                let (right_area, right_count) = right[k + 1];
+                let cost = half_area(left.0) * tests(left.1) + right_area * tests(right_count);
+                if left.1 > 0 && right_count > 0 && cost < best.0 {
+                    best = (cost, axis, k);
+                }
             }
         }
+        if best.0 == f32::INFINITY {
+            // Every centroid in one place: halve by count once too many
+            return (range.len() > 2 * LEAF).then_some(range.len() / 2);
+        }
         // A leaf costs a test of each primitive; a split, a box test more
-        let leaf = half_area(node) * range.len() as f32;
+        let leaf = half_area(node) * tests(range.len());
         if best.0 >= leaf && range.len() <= 2 * LEAF {
             return None;
         }
-        if best.0 == f32::INFINITY {
-            return Some(range.len() / 2);
-        }
-        // Partition: bins up to `best.1` to the left
+        // Partition: bins up to the best's to the left
+        let (_, axis, last) = best;
         let mut middle = 0;
         for j in 0..range.len() {
-            if bin_of(range[j]) <= best.1 {
+            if bin_of(range[j], axis) <= last {
                 range.swap(j, middle);
                 middle += 1;
             }
         }
         Some(middle)
+    }
+
+    /// Sorts `range` about its median along the axis its centroids spread
+    /// most on, and says where its right half starts.
+    fn median(range: &mut [u32], centroids: &[Vec3]) -> usize {
+        let (lo, hi) = range.iter().fold(EMPTY, |b, &i| union(b, (centroids[i as usize], centroids[i as usize])));
+        let axis = (hi - lo).max_position();
+        let middle = range.len() / 2;
+        range.select_nth_unstable_by(middle, |&a, &b| {
+            centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis])
+        });
+        middle
     }
 
     /// The ray as the box tests take it: its origin and the inverse of its
@@ -212,13 +263,51 @@ impl Bvh {
         t_max: f32,
         mut test: impl FnMut(u32, f32) -> Option<(f32, H)>,
     ) -> Option<(u32, H)> {
-        if self.order.is_empty() {
+        self.nearest_leaf(
+            ray,
+            t_max,
+            |_, _| {},
+            |start, count, mut best_t| {
+                let mut found = None;
+                for &i in &self.order[start as usize..(start + count) as usize] {
+                    if let Some((t, hit)) = test(i, best_t) {
+                        best_t = t;
+                        found = Some((t, (i, hit)));
+                    }
+                }
+                found
+            },
+        )
+    }
+
+    /// Whether `test` (given a primitive) holds for any primitive whose box
+    /// the ray meets within (0, t_max).
+    #[inline]
+    pub fn any_hit(&self, ray: &Ray, t_max: f32, mut test: impl FnMut(u32) -> bool) -> bool {
+        self.any_leaf(ray, t_max, |start, count| {
+            self.order[start as usize..(start + count) as usize].iter().any(|&i| test(i))
+        })
+    }
+
+    /// As `nearest`, a leaf at a time: `test` is given a leaf's (start,
+    /// count) (its run of `order`, or what `map_leaves` made of it) and the
+    /// nearest hit so far, and answers with the leaf's nearer hit;
+    /// `prefetch_leaf` may ask the memory for a leaf the ray will test.
+    #[inline]
+    pub fn nearest_leaf<H>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        prefetch_leaf: impl Fn(u32, u32),
+        mut test: impl FnMut(u32, u32, f32) -> Option<(f32, H)>,
+    ) -> Option<H> {
+        if self.wide.is_empty() {
             return None;
         }
         let lanes = Self::lanes_of(ray);
         let mut best_t = t_max;
         let mut found = None;
-        // (start, count, entry): a wide node (count 0) or a leaf's primitives
+        // (start, count, entry): a wide node (count 0) or a leaf
         let mut stack = [(0u32, 0u32, 0.0f32); STACK];
         let mut depth = 1;
         while depth > 0 {
@@ -228,16 +317,15 @@ impl Bvh {
                 continue;
             }
             if count > 0 {
-                for &i in &self.order[start as usize..(start + count) as usize] {
-                    if let Some((t, hit)) = test(i, best_t) {
-                        best_t = t;
-                        found = Some((i, hit));
-                    }
+                if let Some((t, hit)) = test(start, count, best_t) {
+                    best_t = t;
+                    found = Some(hit);
                 }
                 continue;
             }
             let node = &self.wide[start as usize];
             let (mut met, near) = Self::enter(node, &lanes, best_t);
+            self.prefetch(node, met, &prefetch_leaf);
             let near = near.to_array();
             // Farthest first onto the stack, so the nearest comes off first
             let first = depth;
@@ -249,18 +337,33 @@ impl Bvh {
                     stack[at] = stack[at - 1];
                     at -= 1;
                 }
-                stack[at] = (node.start[k], node.count[k], near[k]);
+                stack[at] = (node.start[k], node.count[k] as u32, near[k]);
                 depth += 1;
             }
         }
         found
     }
 
-    /// Whether `test` (given a primitive) holds for any primitive whose box
-    /// the ray meets within (0, t_max).
+    /// Asks the memory for `node`'s children `met`, all at once: the
+    /// inner nodes here, the leaves through `prefetch_leaf` (given a leaf's
+    /// start and count). A ray that goes on to more than one of them finds
+    /// the later ones waiting, where it would wait for each in turn.
+    #[inline(always)]
+    fn prefetch(&self, node: &Wide, mut met: u32, prefetch_leaf: &impl Fn(u32, u32)) {
+        while met != 0 {
+            let k = met.trailing_zeros() as usize;
+            met &= met - 1;
+            match node.count[k] {
+                0 => prefetch_lines(&self.wide[node.start[k] as usize], 2),
+                count => prefetch_leaf(node.start[k], count as u32),
+            }
+        }
+    }
+
+    /// As `any_hit`, a leaf at a time (as `nearest_leaf` gives them).
     #[inline]
-    pub fn any_hit(&self, ray: &Ray, t_max: f32, mut test: impl FnMut(u32) -> bool) -> bool {
-        if self.order.is_empty() {
+    pub fn any_leaf(&self, ray: &Ray, t_max: f32, mut test: impl FnMut(u32, u32) -> bool) -> bool {
+        if self.wide.is_empty() {
             return false;
         }
         let lanes = Self::lanes_of(ray);
@@ -270,7 +373,7 @@ impl Bvh {
             depth -= 1;
             let (start, count) = stack[depth];
             if count > 0 {
-                if self.order[start as usize..(start + count) as usize].iter().any(|&i| test(i)) {
+                if test(start, count) {
                     return true;
                 }
                 continue;
@@ -280,11 +383,32 @@ impl Bvh {
             while met != 0 {
                 let k = met.trailing_zeros() as usize;
                 met &= met - 1;
-                stack[depth] = (node.start[k], node.count[k]);
+                stack[depth] = (node.start[k], node.count[k] as u32);
                 depth += 1;
             }
         }
         false
+    }
+
+    /// Renames every leaf: `rename` is given a leaf's primitives and
+    /// answers with the (start, count) the leaf tests will be given in
+    /// their place, the count no more than the primitives; a count of zero
+    /// removes the leaf (nothing in it can be hit).
+    pub fn map_leaves(&mut self, mut rename: impl FnMut(&[u32]) -> (u32, u32)) {
+        for node in &mut self.wide {
+            for k in 0..4 {
+                if node.valid & (1 << k) == 0 || node.count[k] == 0 {
+                    continue;
+                }
+                let (start, count) = (node.start[k] as usize, node.count[k] as usize);
+                let (renamed, count) = rename(&self.order[start..start + count]);
+                // No more than the leaf's primitives, so it fits
+                (node.start[k], node.count[k]) = (renamed, count.min(2 * LEAF as u32) as u8);
+                if node.count[k] == 0 {
+                    node.valid &= !(1 << k);
+                }
+            }
+        }
     }
 
     /// The binary tree `nodes` as four-wide nodes: each takes its node's
@@ -320,7 +444,7 @@ impl Bvh {
                         wide.push(Wide::EMPTY);
                         (wide.len() as u32 - 1, 0)
                     }
-                    count => (child.start, count),
+                    count => (child.start, count as u8),
                 };
             }
             wide[at] = filled;
@@ -373,7 +497,7 @@ mod tests {
         let mut s = Sampler::new(0, 0, 57);
         for count in [0usize, 1, 3, 5, 40, 300, 2000] {
             let list = triangles(&mut s, count);
-            let bvh = Bvh::new(&bounds_of(&list));
+            let bvh = Bvh::new(&bounds_of(&list), 1 + count % 4);
             let mut leaves: Vec<u32> = bvh.order.clone();
             leaves.sort_unstable();
             assert_eq!(leaves, (0..count as u32).collect::<Vec<_>>());
@@ -414,7 +538,7 @@ mod tests {
     fn a_ray_tests_few_of_many_primitives() {
         let mut s = Sampler::new(0, 0, 58);
         let list = triangles(&mut s, 20_000);
-        let bvh = Bvh::new(&bounds_of(&list));
+        let bvh = Bvh::new(&bounds_of(&list), 4);
         let (mut tested, rays) = (0usize, 500);
         for _ in 0..rays {
             let ray = Ray::new(uniform_sphere(s.next_2d()) * 8.0, uniform_sphere(s.next_2d()));
@@ -426,5 +550,42 @@ mod tests {
         let mean = tested as f32 / rays as f32;
         assert!(mean < 0.02 * list.len() as f32, "{mean} triangles tested a ray, of {}", list.len());
         assert!(bvh.wide.len() < list.len());
+    }
+
+    /// Past its median depth the build halves what is left: every leaf
+    /// holds at most `2 * LEAF` primitives (`LEAF` once only halves made
+    /// it), each primitive is in one, and the tree is no deeper than the
+    /// median depth and the halvings (`MAX_DEPTH`'s bound).
+    #[test]
+    fn past_the_median_depth_the_build_halves() {
+        let mut s = Sampler::new(0, 0, 59);
+        let list = triangles(&mut s, 1000);
+        for median_depth in [0, 3, MEDIAN_DEPTH] {
+            let mut bvh = Bvh::build(&bounds_of(&list), 1, median_depth);
+            let mut seen = Vec::new();
+            let most = if median_depth == 0 { LEAF } else { 2 * LEAF };
+            bvh.map_leaves(|ids| {
+                assert!(ids.len() <= most, "a leaf of {} past depth {median_depth}", ids.len());
+                seen.extend_from_slice(ids);
+                (0, ids.len() as u32)
+            });
+            seen.sort_unstable();
+            assert_eq!(seen, (0..list.len() as u32).collect::<Vec<_>>());
+            // Halvings of 1000 down to at most four: 8
+            assert!(depth(&bvh, 0) <= median_depth + 8, "depth {} past {median_depth}", depth(&bvh, 0));
+        }
+    }
+
+    /// Levels of four-wide nodes below `node` (at most the binary tree's).
+    fn depth(bvh: &Bvh, node: usize) -> usize {
+        let wide = &bvh.wide[node];
+        let inner = (0..4).filter(|&k| wide.valid & (1 << k) != 0 && wide.count[k] == 0);
+        1 + inner.map(|k| depth(bvh, wide.start[k] as usize)).max().unwrap_or(0)
+    }
+
+    /// A node is two cache lines, and starts one.
+    #[test]
+    fn a_node_is_two_cache_lines() {
+        assert_eq!((std::mem::size_of::<Wide>(), std::mem::align_of::<Wide>()), (128, 64));
     }
 }

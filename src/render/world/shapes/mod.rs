@@ -12,6 +12,7 @@ pub mod mesh_light;
 pub mod plane;
 pub mod sphere;
 pub mod triangle;
+pub mod triangle_tree;
 
 use std::sync::Arc;
 
@@ -21,12 +22,12 @@ use crate::geometry::real::{Real, V3};
 use crate::geometry::{Ray, SurfaceHit, Triangle};
 use crate::scene::mesh::Meshes;
 use crate::scene::Shape;
-use bvh::Bvh;
 pub use mesh_light::MeshEmitter;
 pub use plane::PlaneShape;
 use sphere::Sphere;
 pub use sphere::{CappedSphere, EmitterCap, SphereLanes, SphereReach, Spheres};
 pub use triangle::TriangleLanes;
+pub use triangle_tree::TriangleTree;
 
 /// What a shape that can be an area light answers, written once per kind;
 /// `light::Emitter` dispatches to it.
@@ -135,7 +136,7 @@ pub struct Shapes {
     /// scene of a few of them.
     pub(crate) triangle_lanes: TriangleLanes,
     /// A hierarchy over them, for a scene of many (`GROUPED_TRIANGLES`).
-    pub(crate) triangle_bvh: Option<Arc<Bvh>>,
+    pub(crate) triangle_tree: Option<Arc<TriangleTree>>,
 }
 
 /// Up to how many triangles a ray tests them all, four at a time, rather
@@ -143,7 +144,7 @@ pub struct Shapes {
 pub const GROUPED_TRIANGLES: usize = 64;
 
 /// Each triangle's box.
-fn triangle_boxes(triangles: &[(Triangle, u32)]) -> Vec<(Vec3, Vec3)> {
+pub(super) fn triangle_boxes(triangles: &[(Triangle, u32)]) -> Vec<(Vec3, Vec3)> {
     (triangles.iter())
         .map(|(t, _)| {
             let [a, b, c] = t.vertices;
@@ -195,19 +196,19 @@ impl Shapes {
             })
             .collect();
         Triangle::share_planes(&mut triangles.iter_mut().map(|(triangle, _)| triangle).collect::<Vec<_>>());
-        let (triangle_lanes, triangle_bvh) = match triangles.len() > GROUPED_TRIANGLES {
-            true => (TriangleLanes::default(), Some(Arc::new(Bvh::new(&triangle_boxes(&triangles))))),
+        let (triangle_lanes, triangle_tree) = match triangles.len() > GROUPED_TRIANGLES {
+            true => (TriangleLanes::default(), Some(Arc::new(TriangleTree::new(&triangles)))),
             false => (TriangleLanes::new(&triangles), None),
         };
-        (Shapes { spheres: Spheres::new(spheres), planes, triangles, triangle_lanes, triangle_bvh }, refs)
+        (Shapes { spheres: Spheres::new(spheres), planes, triangles, triangle_lanes, triangle_tree }, refs)
     }
 
-    /// The nearest triangle on the ray within (0, t_max) and the hit:
-    /// what `intersect_triangle` over the triangles finds.
+    /// The nearest triangle on the ray within (0, t_max), its object and
+    /// the hit: what `intersect_triangle` over the triangles finds.
     #[inline]
-    pub fn nearest_triangle(&self, ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
-        match &self.triangle_bvh {
-            Some(bvh) => triangle::nearest_in(bvh, |i| &self.triangles[i as usize].0, ray, t_max),
+    pub fn nearest_triangle(&self, ray: &Ray, t_max: f32) -> Option<(u32, u32, SurfaceHit)> {
+        match &self.triangle_tree {
+            Some(tree) => tree.nearest(|i| &self.triangles[i as usize].0, ray, t_max),
             None => self.triangle_lanes.nearest(&self.triangles, ray, t_max),
         }
     }
@@ -216,8 +217,8 @@ impl Shapes {
     /// (0, t_max).
     #[inline]
     pub fn any_triangle(&self, ray: &Ray, t_max: f32, skip: impl Fn(u32) -> bool) -> bool {
-        match &self.triangle_bvh {
-            Some(bvh) => triangle::any_in(bvh, |i| &self.triangles[i as usize].0, ray, t_max, skip),
+        match &self.triangle_tree {
+            Some(tree) => tree.any_hit(|i| &self.triangles[i as usize].0, ray, t_max, skip),
             None => self.triangle_lanes.any_hit(&self.triangles, ray, t_max, skip),
         }
     }

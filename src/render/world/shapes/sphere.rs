@@ -107,7 +107,7 @@ impl Spheres {
     pub fn new(list: Vec<Sphere>) -> Self {
         if list.len() > GROUPED_SPHERES {
             let boxes: Vec<(Vec3, Vec3)> = list.iter().map(|s| (s.center - s.radius, s.center + s.radius)).collect();
-            return Spheres { bvh: Some(Arc::new(Bvh::new(&boxes))), list, lanes: SphereLanes::default() };
+            return Spheres { bvh: Some(Arc::new(Bvh::new(&boxes, 1))), list, lanes: SphereLanes::default() };
         }
         let centers: Vec<Vec3> = list.iter().map(|s| s.center).collect();
         let radii: Vec<f32> = list.iter().map(|s| s.radius).collect();

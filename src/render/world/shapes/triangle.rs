@@ -11,29 +11,63 @@
 
 use glam::{BVec4A, DVec3, Vec2, Vec3, Vec4};
 
-use super::bvh::Bvh;
+use super::bvh::prefetch_lines;
 use super::{solid_angle_pdf, AreaEmitter};
 use crate::geometry::real::{Real, V3};
 use crate::geometry::{
-    beyond, edges_of, triangle_hit_of, watertight_finish_of, watertight_range_of, Crossing, RayShear,
+    beyond, edges_of, triangle_hit_of, watertight_finish_of, watertight_range_of, Crossing, CullPlane, RayShear,
 };
 use crate::geometry::{gamma, intersect_triangle, Ray, SurfaceHit, Triangle};
 use crate::render::world::sampling::uniform_triangle;
 
-/// Four triangles' vertices, planes and edges (`geometry::cull`), lane by
-/// lane.
+/// Four triangles, lane by lane: first what the cull reads (planes and
+/// edges, `geometry::cull`) and the triangles' names, four cache lines;
+/// then what a hit reads, a line of objects and normals, and the vertices
+/// the watertight test reads where the cull is not sure.
 #[derive(Clone, Debug)]
+#[repr(C, align(64))]
 struct Group {
-    vertices: [V3<Vec4>; 3],
     normal: V3<Vec4>,
     offset: Vec4,
     scale: Vec4,
-    /// Which axes each plane keeps: (y or x, y or z).
-    drop_x: BVec4A,
-    drop_z: BVec4A,
     edges: [[Vec4; 3]; 3],
-    /// Lanes that hold a triangle (the last group may be part empty).
-    full: u32,
+    /// The world's index of each lane's triangle.
+    ids: [u32; 4],
+    /// A bit a lane: where its plane drops x (keeps y, z), where it drops
+    /// z (keeps x, y), and whether it holds a triangle (the last group of
+    /// a run may be part empty): bits 0–3, 4–7, 8–11.
+    lanes: u32,
+    /// The fifth line: each triangle's normal (its plane's is its run's
+    /// first triangle's), and its object.
+    normals: V3<Vec4>,
+    objects: [u32; 4],
+    vertices: [V3<Vec4>; 3],
+}
+
+impl Group {
+    /// The lanes whose bit `shift`…`shift + 3` of `lanes` is set.
+    #[inline(always)]
+    fn mask(&self, shift: u32) -> BVec4A {
+        let bits = self.lanes >> shift;
+        BVec4A::new(bits & 1 != 0, bits & 2 != 0, bits & 4 != 0, bits & 8 != 0)
+    }
+
+    #[inline(always)]
+    fn full(&self) -> u32 {
+        (self.lanes >> 8) & 0xf
+    }
+
+    /// Lane `k`'s triangle's plane, as `hit_point` reads it.
+    #[inline(always)]
+    fn plane(&self, k: usize) -> CullPlane {
+        let normal = Vec3::new(self.normal.x[k], self.normal.y[k], self.normal.z[k]);
+        CullPlane { normal, offset: self.offset[k], scale: self.scale[k], drop: 0 }
+    }
+
+    #[inline(always)]
+    fn triangle_normal(&self, k: usize) -> Vec3 {
+        Vec3::new(self.normals.x[k], self.normals.y[k], self.normals.z[k])
+    }
 }
 
 /// What one group's lanes found for a ray within (0, t_max).
@@ -58,101 +92,151 @@ struct Verdict {
 #[derive(Clone, Debug, Default)]
 pub struct TriangleLanes {
     groups: Vec<Group>,
-    /// The world's index of the triangle in each lane, in order
-    /// (degenerate triangles, which nothing hits, are left out).
-    ids: Vec<u32>,
 }
 
 impl TriangleLanes {
     pub fn new(triangles: &[(Triangle, u32)]) -> Self {
-        let ids: Vec<u32> = (0..triangles.len() as u32).filter(|&i| !triangles[i as usize].0.is_degenerate()).collect();
-        let groups = ids
-            .chunks(4)
-            .map(|chunk| {
-                // Empty lanes copy the first triangle and are masked off by `full`
-                let lane = |k: usize| &triangles[chunk[k.min(chunk.len() - 1)] as usize].0;
-                let vec = |f: &dyn Fn(&Triangle) -> f32| Vec4::from_array([0, 1, 2, 3].map(|k| f(lane(k))));
-                let point =
-                    |f: &dyn Fn(&Triangle) -> glam::Vec3| V3::new(vec(&|t| f(t).x), vec(&|t| f(t).y), vec(&|t| f(t).z));
-                let drops = |axis: usize| BVec4A::from_array([0, 1, 2, 3].map(|k| lane(k).cull.plane.drop == axis));
-                let edge = |e: usize, i: usize| vec(&|t| t.cull.edges.0[e][i]);
-                Group {
-                    vertices: [point(&|t| t.vertices[0]), point(&|t| t.vertices[1]), point(&|t| t.vertices[2])],
-                    normal: point(&|t| t.cull.plane.normal),
-                    offset: vec(&|t| t.cull.plane.offset),
-                    scale: vec(&|t| t.cull.plane.scale),
-                    drop_x: drops(0),
-                    drop_z: drops(2),
-                    edges: [0, 1, 2].map(|e| [edge(e, 0), edge(e, 1), edge(e, 2)]),
-                    full: (1 << chunk.len()) - 1,
-                }
-            })
-            .collect();
-        TriangleLanes { groups, ids }
+        let mut lanes = TriangleLanes::default();
+        let ids: Vec<u32> = (0..triangles.len() as u32).collect();
+        lanes.push_run(triangles, &ids);
+        lanes
+    }
+
+    /// Groups for the triangles `ids` names after those already held, in
+    /// their order (degenerate triangles, which nothing hits, left out):
+    /// the range of groups they take, as (first, count).
+    pub fn push_run(&mut self, triangles: &[(Triangle, u32)], ids: &[u32]) -> (u32, u32) {
+        let first = self.groups.len() as u32;
+        let kept: Vec<u32> = ids.iter().copied().filter(|&i| !triangles[i as usize].0.is_degenerate()).collect();
+        for chunk in kept.chunks(4) {
+            // Empty lanes copy the last triangle and are masked off
+            let id = |k: usize| chunk[k.min(chunk.len() - 1)];
+            let lane = |k: usize| &triangles[id(k) as usize].0;
+            let vec = |f: &dyn Fn(&Triangle) -> f32| Vec4::from_array([0, 1, 2, 3].map(|k| f(lane(k))));
+            let point = |f: &dyn Fn(&Triangle) -> Vec3| V3::new(vec(&|t| f(t).x), vec(&|t| f(t).y), vec(&|t| f(t).z));
+            let drops = |axis: usize| (0..4).filter(|&k| lane(k).cull.plane.drop == axis).map(|k| 1 << k).sum::<u32>();
+            let edge = |e: usize, i: usize| vec(&|t| t.cull.edges.0[e][i]);
+            self.groups.push(Group {
+                normal: point(&|t| t.cull.plane.normal),
+                offset: vec(&|t| t.cull.plane.offset),
+                scale: vec(&|t| t.cull.plane.scale),
+                edges: [0, 1, 2].map(|e| [edge(e, 0), edge(e, 1), edge(e, 2)]),
+                ids: [0, 1, 2, 3].map(id),
+                objects: [0, 1, 2, 3].map(|k| triangles[id(k) as usize].1),
+                lanes: drops(0) | drops(2) << 4 | ((1 << chunk.len()) - 1) << 8,
+                normals: point(&|t| t.normal),
+                vertices: [point(&|t| t.vertices[0]), point(&|t| t.vertices[1]), point(&|t| t.vertices[2])],
+            });
+        }
+        (first, self.groups.len() as u32 - first)
+    }
+
+    /// Asks the memory for what the cull and a hit read of group `g` (all
+    /// but the vertices).
+    #[inline(always)]
+    pub fn prefetch(&self, g: u32) {
+        if let Some(group) = self.groups.get(g as usize) {
+            prefetch_lines(group, 5);
+        }
     }
 
     /// One group against `ray` within (0, t_max); `None` where the cull
-    /// turns the ray away in every lane (most groups, for most rays).
+    /// turns the ray away in every lane (most groups, for most rays). The
+    /// watertight test runs only where the cull lets a lane through but is
+    /// not sure of it, so a group whose lanes it settles reads none of its
+    /// vertices.
     #[inline(always)]
     fn verdict(group: &Group, ray: &Ray, shear: &RayShear<Vec4>, t_max: f32) -> Option<Verdict> {
         let (origin, direction) = (V3::<Vec4>::splat(ray.origin), V3::<Vec4>::splat(ray.direction));
         let limit = Vec4::splat(t_max);
         let (t, point, slack) = Crossing::point_of(origin, direction, group.normal, group.offset, group.scale);
-        let u = Vec4::select(group.drop_x, point.y, point.x);
-        let v = Vec4::select(group.drop_z, point.y, point.z);
+        let u = Vec4::select(group.mask(0), point.y, point.x);
+        let v = Vec4::select(group.mask(4), point.y, point.z);
         let crossing = Crossing { t, u, v, slack };
         let (turned_away, sure) = crossing.test(&group.edges, limit);
-        let reach = !turned_away.bitmask() & group.full;
+        let reach = !turned_away.bitmask() & group.full();
         if reach == 0 {
             return None;
+        }
+        let sure = sure.bitmask() & reach;
+        let mut verdict = Verdict {
+            hit: 0,
+            sure,
+            crossing,
+            scalar: 0,
+            t: Vec4::ZERO,
+            t_scaled: Vec4::ZERO,
+            det: Vec4::ZERO,
+            barycentrics: [Vec4::ZERO; 3],
+        };
+        if reach == sure {
+            return Some(verdict);
         }
         let (sheared, sz) = shear.vertices(group.vertices);
         let edges = edges_of(sheared);
         let zero = Vec4::ZERO;
         let on_edge: BVec4A = edges[0].cmpeq(zero) | edges[1].cmpeq(zero) | edges[2].cmpeq(zero);
-        let scalar = on_edge.bitmask() & reach;
+        let scalar = on_edge.bitmask() & reach & !sure;
         let range = watertight_range_of(sheared, edges, sz, limit);
-        let within = reach & !range.missed.bitmask() & !scalar;
-        let sure = sure.bitmask() & group.full;
+        let within = reach & !sure & !range.missed.bitmask() & !scalar;
         if within == 0 && scalar == 0 && sure == 0 {
             return None;
         }
         let (t, hit, barycentrics) = watertight_finish_of(sheared, edges, range);
-        let (t_scaled, det) = (range.t_scaled, range.det);
-        Some(Verdict { hit: hit.bitmask() & within, sure, crossing, scalar, t, t_scaled, det, barycentrics })
+        (verdict.hit, verdict.scalar, verdict.t, verdict.barycentrics) =
+            (hit.bitmask() & within, scalar, t, barycentrics);
+        (verdict.t_scaled, verdict.det) = (range.t_scaled, range.det);
+        Some(verdict)
     }
 
-    /// Nearest hit in (0, t_max): (the world's triangle index, the hit),
-    /// exactly what `intersect_triangle` over the triangles in order finds.
+    /// Nearest hit in (0, t_max): (the world's triangle index, its
+    /// object, the hit), exactly what `intersect_triangle` over the
+    /// triangles in order finds.
     #[inline]
-    pub fn nearest(&self, triangles: &[(Triangle, u32)], ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
+    pub fn nearest(&self, triangles: &[(Triangle, u32)], ray: &Ray, t_max: f32) -> Option<(u32, u32, SurfaceHit)> {
+        let shear = RayShear::of_one_ray(ray.origin, ray.direction);
+        self.nearest_in(0..self.groups.len() as u32, |i| &triangles[i as usize].0, ray, &shear, t_max)
+    }
+
+    /// The nearest hit in (0, t_max) among the groups `range` (`shear` the
+    /// ray's, `triangle` each triangle by its index, for the rare ray the
+    /// scalar test decides), as `nearest`.
+    #[inline(always)]
+    pub fn nearest_in<'t>(
+        &self,
+        range: std::ops::Range<u32>,
+        triangle: impl Fn(u32) -> &'t Triangle,
+        ray: &Ray,
+        shear: &RayShear<Vec4>,
+        t_max: f32,
+    ) -> Option<(u32, u32, SurfaceHit)> {
         let mut best_t = t_max;
         let mut found = None;
-        let shear = RayShear::of_one_ray(ray.origin, ray.direction);
-        for (g, group) in self.groups.iter().enumerate() {
-            let Some(verdict) = Self::verdict(group, ray, &shear, best_t) else { continue };
+        for group in &self.groups[range.start as usize..range.end as usize] {
+            let Some(verdict) = Self::verdict(group, ray, shear, best_t) else { continue };
             let (mut lanes, mut narrowed) = (verdict.hit | verdict.scalar | verdict.sure, false);
             while lanes != 0 {
                 let lane = lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
-                let id = self.ids[g * 4 + lane];
-                let triangle = &triangles[id as usize].0;
-                let (crossing_t, slack) =
-                    (verdict.crossing.t.to_array()[lane], verdict.crossing.slack.to_array()[lane]);
+                let (id, object) = (group.ids[lane], group.objects[lane]);
+                let (crossing_t, slack) = (verdict.crossing.t[lane], verdict.crossing.slack[lane]);
+                let sure = verdict.sure & (1 << lane) != 0;
                 // Sure against the group's t_max, and still against a nearer
                 // one: the crossing is the hit, as `intersect_triangle` takes it
-                if verdict.sure & (1 << lane) != 0 && (!narrowed || crossing_t + slack < best_t) {
+                if sure && (!narrowed || crossing_t + slack < best_t) {
                     let (point, error) =
-                        triangle.cull.plane.hit_point(ray.origin.into(), ray.direction.into(), crossing_t);
+                        group.plane(lane).hit_point(ray.origin.into(), ray.direction.into(), crossing_t);
+                    let normal = group.triangle_normal(lane);
                     (best_t, narrowed) = (crossing_t, true);
-                    found =
-                        Some((id, SurfaceHit { t: crossing_t, point: point.into(), normal: triangle.normal, error }));
+                    found = Some((id, object, SurfaceHit { t: crossing_t, point: point.into(), normal, error }));
                     continue;
                 }
-                if verdict.scalar & (1 << lane) != 0 {
-                    if let Some(hit) = intersect_triangle(ray, triangle, best_t) {
+                // No longer sure against a nearer hit, or on an edge: what
+                // the scalar loop does there
+                if sure || verdict.scalar & (1 << lane) != 0 {
+                    if let Some(hit) = intersect_triangle(ray, triangle(id), best_t) {
                         (best_t, narrowed) = (hit.t, true);
-                        found = Some((id, hit));
+                        found = Some((id, object, hit));
                     }
                     continue;
                 }
@@ -163,7 +247,7 @@ impl TriangleLanes {
                 // nearer: the scalar loop would test both cull and hit
                 // against it
                 if narrowed {
-                    let (t_scaled, det) = (verdict.t_scaled.to_array()[lane], verdict.det.to_array()[lane]);
+                    let (t_scaled, det) = (verdict.t_scaled[lane], verdict.det[lane]);
                     let bound = best_t * det;
                     if beyond(crossing_t, slack, best_t)
                         || (det < 0.0 && t_scaled < bound)
@@ -172,10 +256,12 @@ impl TriangleLanes {
                         continue;
                     }
                 }
-                let b = verdict.barycentrics.map(|b| b.to_array()[lane]);
-                let (point, error) = triangle_hit_of(triangle.vertices.map(V3::from), b);
-                (best_t, narrowed) = (verdict.t.to_array()[lane], true);
-                found = Some((id, SurfaceHit { t: best_t, point: point.into(), normal: triangle.normal, error }));
+                let b = verdict.barycentrics.map(|b| b[lane]);
+                let vertices = group.vertices.map(|v| V3::new(v.x[lane], v.y[lane], v.z[lane]));
+                let (point, error) = triangle_hit_of(vertices, b);
+                (best_t, narrowed) = (verdict.t[lane], true);
+                let normal = group.triangle_normal(lane);
+                found = Some((id, object, SurfaceHit { t: best_t, point: point.into(), normal, error }));
             }
         }
         found
@@ -186,18 +272,33 @@ impl TriangleLanes {
     #[inline]
     pub fn any_hit(&self, triangles: &[(Triangle, u32)], ray: &Ray, t_max: f32, skip: impl Fn(u32) -> bool) -> bool {
         let shear = RayShear::of_one_ray(ray.origin, ray.direction);
-        self.groups.iter().enumerate().any(|(g, group)| {
-            let Some(verdict) = Self::verdict(group, ray, &shear, t_max) else { return false };
+        self.any_in(0..self.groups.len() as u32, |i| &triangles[i as usize].0, ray, &shear, t_max, skip)
+    }
+
+    /// Whether any triangle of the groups `range` but those `skip` names
+    /// lies on the ray in (0, t_max), `shear` the ray's.
+    #[inline(always)]
+    pub fn any_in<'t>(
+        &self,
+        range: std::ops::Range<u32>,
+        triangle: impl Fn(u32) -> &'t Triangle,
+        ray: &Ray,
+        shear: &RayShear<Vec4>,
+        t_max: f32,
+        skip: impl Fn(u32) -> bool,
+    ) -> bool {
+        self.groups[range.start as usize..range.end as usize].iter().any(|group| {
+            let Some(verdict) = Self::verdict(group, ray, shear, t_max) else { return false };
             let mut lanes = verdict.hit | verdict.sure | verdict.scalar;
             while lanes != 0 {
                 let lane = lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
-                let id = self.ids[g * 4 + lane];
+                let id = group.ids[lane];
                 if skip(id) {
                     continue;
                 }
                 if (verdict.hit | verdict.sure) & (1 << lane) != 0
-                    || intersect_triangle(ray, &triangles[id as usize].0, t_max).is_some()
+                    || intersect_triangle(ray, triangle(id), t_max).is_some()
                 {
                     return true;
                 }
@@ -205,31 +306,6 @@ impl TriangleLanes {
             false
         })
     }
-}
-
-/// The nearest of the triangles `bvh` holds (`triangle` gives each) on
-/// the ray within (0, t_max), and the hit: `intersect_triangle`'s.
-#[inline]
-pub fn nearest_in<'t>(
-    bvh: &Bvh,
-    triangle: impl Fn(u32) -> &'t Triangle,
-    ray: &Ray,
-    t_max: f32,
-) -> Option<(u32, SurfaceHit)> {
-    bvh.nearest(ray, t_max, |i, best_t| intersect_triangle(ray, triangle(i), best_t).map(|hit| (hit.t, hit)))
-}
-
-/// Whether any triangle `bvh` holds but those `skip` names lies on the ray
-/// within (0, t_max).
-#[inline]
-pub fn any_in<'t>(
-    bvh: &Bvh,
-    triangle: impl Fn(u32) -> &'t Triangle,
-    ray: &Ray,
-    t_max: f32,
-    skip: impl Fn(u32) -> bool,
-) -> bool {
-    bvh.any_hit(ray, t_max, |i| !skip(i) && intersect_triangle(ray, triangle(i), t_max).is_some())
 }
 
 /// The point of barycentrics (b0, b1, 1 − b0 − b1) on a triangle, for one
@@ -311,6 +387,19 @@ mod tests {
         out.into_iter().zip(0..).collect()
     }
 
+    /// What the cull reads of a group, and the triangles' names, are its
+    /// first four cache lines; what a hit reads, the fifth.
+    #[test]
+    fn a_group_reads_its_lines_in_order() {
+        use std::mem::{align_of, offset_of, size_of};
+        assert_eq!(align_of::<Group>(), 64);
+        assert!(offset_of!(Group, ids) + 16 <= 256 && offset_of!(Group, lanes) + 4 <= 256);
+        assert_eq!(offset_of!(Group, normals), 256);
+        assert_eq!(offset_of!(Group, objects), 256 + size_of::<V3<Vec4>>());
+        assert_eq!(offset_of!(Group, vertices), 320);
+        assert_eq!(size_of::<Group>(), 512);
+    }
+
     /// Nearest hits and shadow tests agree with the scalar loop bit for bit.
     #[test]
     fn lanes_match_the_scalar_test_triangle_by_triangle() {
@@ -344,7 +433,8 @@ mod tests {
                 }
                 let got = lanes.nearest(&list, &ray, t_max);
                 assert_eq!(got.map(|g| g.0), expected.map(|e| e.0), "ray {ray:?}");
-                if let (Some((_, a)), Some((_, b))) = (got, expected) {
+                assert_eq!(got.map(|g| g.1), expected.map(|e| list[e.0 as usize].1));
+                if let (Some((_, _, a)), Some((_, b))) = (got, expected) {
                     hits += 1;
                     assert_eq!([a.t, a.error], [b.t, b.error]);
                     assert_eq!((a.point, a.normal), (b.point, b.normal));
