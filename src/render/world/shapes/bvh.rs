@@ -1,10 +1,12 @@
 //! A bounding volume hierarchy over any primitives given by their boxes:
-//! binned surface-area-heuristic splits (Wald 2007), nodes in one array
-//! with both children of a node side by side, at most `LEAF` primitives a
-//! leaf where they can be split. A ray visits the nearer child first and
-//! skips what lies beyond its nearest hit, so its cost grows with the
-//! logarithm of the primitives, where the groups of four it replaces grow
-//! with their number.
+//! binned surface-area-heuristic splits (Wald 2007) built as a binary tree,
+//! then flattened into eight-wide nodes (`widen`), at most `LEAF`
+//! primitives a leaf where they can be split. A ray visits the nearer
+//! children first and skips what lies beyond its nearest hit, so its cost
+//! grows with the logarithm of the primitives, where the groups of four it
+//! replaces grow with their number. Its time goes to waiting for memory,
+//! node after node: eight children a node halve the levels four would
+//! make, and the children a ray enters are asked for all at once.
 //!
 //! The primitive test is the caller's: what a ray finds is what testing
 //! every primitive in the order the traversal meets them finds, each
@@ -30,9 +32,12 @@ const MEDIAN_DEPTH: usize = 32;
 /// a leaf of any `u32` count of primitives.
 const MAX_DEPTH: usize = MEDIAN_DEPTH + 32;
 
-/// The traversal's stack: a four-wide node is at least one binary level
-/// below its parent, and each leaves at most three children waiting.
-const STACK: usize = 3 * MAX_DEPTH + 1;
+/// The traversal's stack: an eight-wide node is at least one binary level
+/// below its parent, and each leaves at most seven children waiting.
+const STACK: usize = (WIDTH - 1) * MAX_DEPTH + 1;
+
+/// Children a node holds.
+const WIDTH: usize = 8;
 
 /// Asks the memory for the first `lines` cache lines of `what`: a hint,
 /// which changes nothing but when the lines arrive.
@@ -62,31 +67,35 @@ struct Node {
     count: u32,
 }
 
-/// Four children's boxes side by side, tested against a ray at once: two
+/// Eight children's boxes side by side, tested against a ray four at a
+/// time (SSE, which every x86-64 has, where the scalar callers run): four
 /// cache lines.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Wide {
     /// Per axis, each child's low and high bound.
-    lo: [Vec4; 3],
-    hi: [Vec4; 3],
+    /// Per half (children 0–3, 4–7), per axis, each child's low and
+    /// high bound.
+    lo: [[Vec4; 3]; 2],
+    hi: [[Vec4; 3]; 2],
     /// Per child: an inner node's index in `wide`, or a leaf's first
     /// primitive in `order`.
-    start: [u32; 4],
+    start: [u32; WIDTH],
     /// Per child: a leaf's count of primitives (at most `2 * LEAF`, or
     /// what `map_leaves` made of it); 0 for an inner node.
-    count: [u8; 4],
+    count: [u8; WIDTH],
     /// The children it has, a bit each.
     valid: u32,
 }
 
 impl Wide {
-    const EMPTY: Wide = Wide { lo: [Vec4::ZERO; 3], hi: [Vec4::ZERO; 3], start: [0; 4], count: [0; 4], valid: 0 };
+    const EMPTY: Wide =
+        Wide { lo: [[Vec4::ZERO; 3]; 2], hi: [[Vec4::ZERO; 3]; 2], start: [0; WIDTH], count: [0; WIDTH], valid: 0 };
 }
 
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    /// The binary tree as built, four-wide (`widen`): what rays traverse.
+    /// The binary tree as built, eight-wide (`widen`): what rays traverse.
     wide: Vec<Wide>,
     /// Primitive indices, each leaf's a run of them.
     order: Vec<u32>,
@@ -241,15 +250,30 @@ impl Bvh {
     /// child), and where it enters each (the exits pushed out by the slab
     /// test's rounding, so no hit in a box is missed).
     #[inline(always)]
-    fn enter(node: &Wide, (origin, inverse): &([Vec4; 3], [Vec4; 3]), t_max: f32) -> (u32, Vec4) {
+    fn enter(node: &Wide, ray: &([Vec4; 3], [Vec4; 3]), t_max: f32) -> (u32, [f32; WIDTH]) {
+        let (low, low_near) = Self::enter_half(&node.lo[0], &node.hi[0], ray, t_max);
+        let (high, high_near) = Self::enter_half(&node.lo[1], &node.hi[1], ray, t_max);
+        let (low_near, high_near) = (low_near.to_array(), high_near.to_array());
+        let near = std::array::from_fn(|k| if k < 4 { low_near[k] } else { high_near[k - 4] });
+        ((low | high << 4) & node.valid, near)
+    }
+
+    /// `enter` for four children's boxes.
+    #[inline(always)]
+    fn enter_half(
+        lo: &[Vec4; 3],
+        hi: &[Vec4; 3],
+        (origin, inverse): &([Vec4; 3], [Vec4; 3]),
+        t_max: f32,
+    ) -> (u32, Vec4) {
         // Written out: `map`'s closures may be left out of line
-        let (x0, x1) = ((node.lo[0] - origin[0]) * inverse[0], (node.hi[0] - origin[0]) * inverse[0]);
-        let (y0, y1) = ((node.lo[1] - origin[1]) * inverse[1], (node.hi[1] - origin[1]) * inverse[1]);
-        let (z0, z1) = ((node.lo[2] - origin[2]) * inverse[2], (node.hi[2] - origin[2]) * inverse[2]);
+        let (x0, x1) = ((lo[0] - origin[0]) * inverse[0], (hi[0] - origin[0]) * inverse[0]);
+        let (y0, y1) = ((lo[1] - origin[1]) * inverse[1], (hi[1] - origin[1]) * inverse[1]);
+        let (z0, z1) = ((lo[2] - origin[2]) * inverse[2], (hi[2] - origin[2]) * inverse[2]);
         let near = x0.min(x1).max(y0.min(y1)).max(z0.min(z1)).max(Vec4::ZERO);
         let far = x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + 2.0 * gamma(3));
         let met = near.cmple(far) & near.cmplt(Vec4::splat(t_max));
-        (met.bitmask() & node.valid, near)
+        (met.bitmask(), near)
     }
 
     /// The nearest hit within (0, t_max) of `test` (given a primitive and
@@ -326,7 +350,6 @@ impl Bvh {
             let node = &self.wide[start as usize];
             let (mut met, near) = Self::enter(node, &lanes, best_t);
             self.prefetch(node, met, &prefetch_leaf);
-            let near = near.to_array();
             // Farthest first onto the stack, so the nearest comes off first
             let first = depth;
             while met != 0 {
@@ -354,7 +377,7 @@ impl Bvh {
             let k = met.trailing_zeros() as usize;
             met &= met - 1;
             match node.count[k] {
-                0 => prefetch_lines(&self.wide[node.start[k] as usize], 2),
+                0 => prefetch_lines(&self.wide[node.start[k] as usize], 4),
                 count => prefetch_leaf(node.start[k], count as u32),
             }
         }
@@ -396,7 +419,7 @@ impl Bvh {
     /// removes the leaf (nothing in it can be hit).
     pub fn map_leaves(&mut self, mut rename: impl FnMut(&[u32]) -> (u32, u32)) {
         for node in &mut self.wide {
-            for k in 0..4 {
+            for k in 0..WIDTH {
                 if node.valid & (1 << k) == 0 || node.count[k] == 0 {
                     continue;
                 }
@@ -411,9 +434,9 @@ impl Bvh {
         }
     }
 
-    /// The binary tree `nodes` as four-wide nodes: each takes its node's
+    /// The binary tree `nodes` as eight-wide nodes: each takes its node's
     /// children, then opens the largest of those that are inner nodes until
-    /// it holds four.
+    /// it holds eight.
     fn widen(nodes: &[Node]) -> Vec<Wide> {
         let mut wide = vec![Wide::EMPTY];
         let mut todo = vec![(0usize, 0usize)];
@@ -423,7 +446,7 @@ impl Bvh {
                 0 => vec![node.start as usize, node.start as usize + 1],
                 _ => vec![binary],
             };
-            while children.len() < 4 {
+            while children.len() < WIDTH {
                 let area = |&(_, &n): &(usize, &usize)| half_area((nodes[n].lo, nodes[n].hi));
                 let inner = children.iter().enumerate().filter(|(_, &n)| nodes[n].count == 0);
                 let Some((k, _)) = inner.max_by(|a, b| area(a).total_cmp(&area(b))) else { break };
@@ -434,8 +457,8 @@ impl Bvh {
             for (k, &n) in children.iter().enumerate() {
                 let child = &nodes[n];
                 for axis in 0..3 {
-                    filled.lo[axis][k] = child.lo[axis];
-                    filled.hi[axis][k] = child.hi[axis];
+                    filled.lo[k / 4][axis][k % 4] = child.lo[axis];
+                    filled.hi[k / 4][axis][k % 4] = child.hi[axis];
                 }
                 filled.valid |= 1 << k;
                 (filled.start[k], filled.count[k]) = match child.count {
@@ -576,16 +599,16 @@ mod tests {
         }
     }
 
-    /// Levels of four-wide nodes below `node` (at most the binary tree's).
+    /// Levels of eight-wide nodes below `node` (at most the binary tree's).
     fn depth(bvh: &Bvh, node: usize) -> usize {
         let wide = &bvh.wide[node];
-        let inner = (0..4).filter(|&k| wide.valid & (1 << k) != 0 && wide.count[k] == 0);
+        let inner = (0..WIDTH).filter(|&k| wide.valid & (1 << k) != 0 && wide.count[k] == 0);
         1 + inner.map(|k| depth(bvh, wide.start[k] as usize)).max().unwrap_or(0)
     }
 
-    /// A node is two cache lines, and starts one.
+    /// A node is four cache lines, and starts one.
     #[test]
     fn a_node_is_two_cache_lines() {
-        assert_eq!((std::mem::size_of::<Wide>(), std::mem::align_of::<Wide>()), (128, 64));
+        assert_eq!((std::mem::size_of::<Wide>(), std::mem::align_of::<Wide>()), (256, 64));
     }
 }
