@@ -73,7 +73,6 @@ struct Node {
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Wide {
-    /// Per axis, each child's low and high bound.
     /// Per half (children 0–3, 4–7), per axis, each child's low and
     /// high bound.
     lo: [[Vec4; 3]; 2],
