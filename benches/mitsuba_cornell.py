@@ -2,7 +2,9 @@
 """Path tracing on assets/scenes/cornell.ron, GI Studio against Mitsuba 3, side
 by side in one run: samples per second, relMSE against the Cornell box's
 reference, and efficiency 1/(relMSE x seconds), at 320x240 (the reference's
-size) and the same samples per pixel.
+size) and the same samples per pixel. With --meshes, the same on
+assets/scenes/cornell-mesh.ron, whose room is the OBJ files in
+assets/meshes/, which Mitsuba reads too.
 
 Mitsuba is not a dependency of the project: install it beside it, e.g.
     python3 -m venv /tmp/mi && /tmp/mi/bin/pip install mitsuba numpy
@@ -34,7 +36,7 @@ ROOT = Path(__file__).resolve().parent.parent
 WIDTH, HEIGHT = 320, 240
 
 
-def scene_dict(spp):
+def scene_dict(spp, meshes):
     T = mi.ScalarTransform4f
 
     def rgb(r, g, b):
@@ -47,8 +49,27 @@ def scene_dict(spp):
         # A rectangle 200 units wide stands in for an infinite plane
         return {"type": "rectangle", "to_world": to_world @ T().scale(100.0), "bsdf": bsdf}
 
+    def mesh(name, bsdf):
+        # Each quad's own normal: the files hold none, and the room's walls share corners
+        return {"type": "obj", "filename": str(ROOT / "assets/meshes" / name), "face_normals": True, "bsdf": bsdf}
+
     white, red, green = diffuse(0.75, 0.75, 0.75), diffuse(0.75, 0.15, 0.15), diffuse(0.15, 0.6, 0.15)
-    return {
+    if meshes:
+        room = {
+            "white": mesh("cornell-white.obj", white),
+            "left": mesh("cornell-red.obj", red),
+            "right": mesh("cornell-green.obj", green),
+        }
+    else:
+        # A rectangle's normal is +z: each is turned to face the room
+        room = {
+            "floor": plane(T().rotate([1, 0, 0], -90.0), white),
+            "ceiling": plane(T().translate([0.0, 2.0, 0.0]) @ T().rotate([1, 0, 0], 90.0), white),
+            "back": plane(T().translate([0.0, 0.0, -1.0]), white),
+            "left": plane(T().translate([-1.0, 0.0, 0.0]) @ T().rotate([0, 1, 0], 90.0), red),
+            "right": plane(T().translate([1.0, 0.0, 0.0]) @ T().rotate([0, 1, 0], -90.0), green),
+        }
+    return room | {
         "type": "scene",
         "integrator": {"type": "path"},
         "sensor": {
@@ -59,12 +80,6 @@ def scene_dict(spp):
             "film": {"type": "hdrfilm", "width": WIDTH, "height": HEIGHT, "rfilter": {"type": "box"}},
             "sampler": {"type": "independent", "sample_count": spp},
         },
-        # A rectangle's normal is +z: each is turned to face the room
-        "floor": plane(T().rotate([1, 0, 0], -90.0), white),
-        "ceiling": plane(T().translate([0.0, 2.0, 0.0]) @ T().rotate([1, 0, 0], 90.0), white),
-        "back": plane(T().translate([0.0, 0.0, -1.0]), white),
-        "left": plane(T().translate([-1.0, 0.0, 0.0]) @ T().rotate([0, 1, 0], 90.0), red),
-        "right": plane(T().translate([1.0, 0.0, 0.0]) @ T().rotate([0, 1, 0], -90.0), green),
         "mirror": {
             "type": "sphere",
             "center": [-0.45, 0.35, -0.35],
@@ -97,13 +112,15 @@ def main():
     parser.add_argument("--spp", type=int, default=64)
     parser.add_argument("--runs", type=int, default=5, help="interleaved runs of each")
     parser.add_argument("--variant", default="llvm_ad_rgb")
+    parser.add_argument("--meshes", action="store_true", help="the Cornell box whose room is OBJ meshes")
     args = parser.parse_args()
     mi.set_variant(args.variant)
     import drjit as dr
 
-    scene_file = ROOT / "assets/scenes/cornell.ron"
-    reference = ROOT / "assets/references/cornell.exr"
-    scene = mi.load_dict(scene_dict(args.spp))
+    name = "cornell-mesh" if args.meshes else "cornell"
+    scene_file = ROOT / f"assets/scenes/{name}.ron"
+    reference = ROOT / f"assets/references/{name}.exr"
+    scene = mi.load_dict(scene_dict(args.spp, args.meshes))
     # Mitsuba compiles its kernels on the first render: not counted
     dr.eval(mi.render(scene, spp=args.spp))
     dr.sync_thread()
@@ -130,7 +147,7 @@ def main():
             figures["Mitsuba"].append((seconds, rel_mse(args.studio, theirs, reference)))
 
     samples = WIDTH * HEIGHT * args.spp
-    print(f"cornell.ron, path tracing, {WIDTH}x{HEIGHT}, {args.spp} spp, medians of {args.runs} interleaved runs")
+    print(f"{name}.ron, path tracing, {WIDTH}x{HEIGHT}, {args.spp} spp, medians of {args.runs} interleaved runs")
     print(f"{'':10} {'seconds':>8} {'M samples/s':>12} {'relMSE':>9} {'efficiency':>11}")
     efficiency = {}
     for name, runs in figures.items():

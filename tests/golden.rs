@@ -96,6 +96,24 @@ const GOLDEN: &[(&str, &str, u64)] = &[
     ("gap-room", "vcm+everywhere", 0xae39874d96921092),
     ("glossy", "vcm+everywhere", 0x74cd4f4fe0275727),
     ("metals", "vcm+everywhere", 0x34a9db20195cc7ca),
+    ("cornell-mesh", "whitted", 0x793e1f46ea6e7596),
+    ("cornell-mesh", "path", 0x58de9c52620db98a),
+    ("cornell-mesh", "photon", 0x3767748a5681c0e3),
+    ("cornell-mesh", "sppm", 0x23f2fe30ca074451),
+    ("cornell-mesh", "lt", 0x29afcd736a0f4d39),
+    ("cornell-mesh", "bdpt", 0x68c2912cef1636b8),
+    ("cornell-mesh", "bpm", 0x6673bf8777007beb),
+    ("cornell-mesh", "vcm", 0xa9ca71693ee02091),
+    ("cornell-mesh", "vcm+everywhere", 0xd6ce817d17944a3f),
+    ("knot", "whitted", 0x94cb59d1a530f627),
+    ("knot", "path", 0x5966db38feedc0ac),
+    ("knot", "photon", 0x31aa840f4fd776f0),
+    ("knot", "sppm", 0xc5d6023767ba9043),
+    ("knot", "lt", 0xf0a3bf204847d82f),
+    ("knot", "bdpt", 0xf0db2c76fb2aeadb),
+    ("knot", "bpm", 0x0bddd4483ccbf9ed),
+    ("knot", "vcm", 0xf0db2c76fb2aeadb),
+    ("knot", "vcm+everywhere", 0xe88b5982d50d0c12),
 ];
 
 pub fn image_hash(image: &LinearImage) -> u64 {
@@ -139,13 +157,13 @@ fn every_preset_and_algorithm_renders_its_golden_image() {
 }
 
 /// Where no light passes a mirror or glass (lights, gap-room, glossy,
-/// metals), VCM
+/// metals, knot), VCM
 /// (merging on caustic paths only) has no merge to make and weighs every
 /// connection as BDPT does: its image is BDPT's, bit for bit. A merge's
 /// share left in any connection's weight would darken it.
 #[test]
 fn caustic_merges_without_mirrors_or_glass_are_bdpt() {
-    for preset in ["lights", "gap-room", "glossy", "metals"] {
+    for preset in ["lights", "gap-room", "glossy", "metals", "knot"] {
         let (vcm, bdpt) = (golden_render(preset, "vcm"), golden_render(preset, "bdpt"));
         assert!(vcm.pixels == bdpt.pixels, "{preset}: VCM with caustic merges is not BDPT");
     }

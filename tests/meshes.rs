@@ -343,3 +343,103 @@ fn a_screen_blocks_a_mesh_light() {
         assert!(in_lanes.iter().all(|&b| b == blocked), "lanes, screened {blocked}");
     }
 }
+
+/// The built-in scenes' meshes are compiled in and named `builtin:`: such a
+/// scene saved in any folder keeps the name, and opens there.
+#[test]
+fn built_in_meshes_open_and_save_anywhere() {
+    let dir = tempfile::tempdir().expect("a folder");
+    for name in ["cornell-mesh", "knot"] {
+        let scene = gi_studio::scene::presets::preset(name).expect("a preset").expect("it loads").into_scene();
+        let files: Vec<&str> = (scene.objects.iter())
+            .filter_map(|o| match &o.shape {
+                Shape::Mesh { file, .. } => Some(file.as_str()),
+                _ => None,
+            })
+            .collect();
+        assert!(!files.is_empty() && files.iter().all(|f| f.starts_with("builtin:")), "{name}: {files:?}");
+        let path = dir.path().join(format!("{name}.ron"));
+        save_scene(&scene, &path).expect("saved");
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(files.iter().all(|f| text.contains(&format!("file: \"{f}\""))), "{text}");
+        let reopened = load_scene(&path).expect("it opens from another folder").into_scene();
+        assert_eq!(reopened.objects, scene.objects, "{name}");
+        assert_eq!(reopened.meshes, scene.meshes, "{name}");
+    }
+}
+
+#[test]
+fn an_unknown_built_in_mesh_is_refused_naming_the_line() {
+    let text = gi_studio::scene::presets::PRESETS.iter().find(|(n, _)| *n == "knot").expect("the knot").1;
+    let broken = text.replace("builtin:torus-knot.ply", "builtin:teapot.obj");
+    let line = 1 + broken.lines().position(|l| l.contains("teapot")).expect("the mesh's line");
+    match gi_studio::scene::parse_scene(&broken, Path::new("knot.ron")) {
+        Err(SceneFileError::Mesh { line: found, error, .. }) => {
+            assert_eq!(found, line, "{error}");
+            let message = error.to_string();
+            assert!(message.contains("builtin:teapot.obj") && message.contains("builtin:torus-knot.ply"), "{message}");
+        }
+        other => panic!("a scene naming a built-in mesh that is not: {other:?}"),
+    }
+}
+
+/// The knot is a closed surface wound outward: every edge is met once in
+/// each direction by the triangles beside it (so no ray slips between
+/// two), and its signed volume is positive (its normals point out).
+#[test]
+fn the_built_in_knot_is_closed_and_wound_outward() {
+    let mesh = gi_studio::scene::mesh::builtin_mesh("builtin:torus-knot.ply").expect("the knot");
+    let key = |v: Vec3| v.to_array().map(f32::to_bits);
+    let mut edges = std::collections::HashMap::new();
+    for [a, b, c] in &mesh.triangles {
+        for (from, to) in [(a, b), (b, c), (c, a)] {
+            *edges.entry((key(*from), key(*to))).or_insert(0u32) += 1;
+        }
+    }
+    assert!(edges.iter().all(|(&(from, to), &n)| n == 1 && edges.get(&(to, from)) == Some(&1)), "an open edge");
+    let volume: f64 =
+        (mesh.triangles.iter()).map(|[a, b, c]| a.as_dvec3().dot(b.as_dvec3().cross(c.as_dvec3())) / 6.0).sum();
+    // A tube of radius 0.35 along a knot about 2π·√(p²(2²+…)) long: some tens of units³
+    assert!(volume > 1.0, "the knot's volume {volume}: wound inward");
+}
+
+/// A finely tessellated sphere (a UV sphere of 24,576 triangles, its
+/// vertices on the sphere) in place of the diffuse Cornell box's ball
+/// renders the analytic ball's image in mean, by path tracing and the
+/// same seed: within 0.1% (the issue asks 0.5%; with one seed the two
+/// images' noise is alike, measured 0.002% apart, while a ball 3% smaller
+/// moves the mean 0.2%). Without the ball the image differs.
+#[test]
+fn a_finely_tessellated_sphere_renders_as_the_sphere() {
+    let scene = common::detectors::diffuse_cornell();
+    let ball = scene.objects.iter().position(|o| o.name == "glass ball").expect("the glass ball");
+    let Shape::Sphere { center, radius } = scene.objects[ball].shape else { panic!("a sphere") };
+    let (rings, segments) = (96, 128);
+    let point = |i: u32, j: u32| {
+        let (theta, phi) =
+            (std::f32::consts::PI * i as f32 / rings as f32, std::f32::consts::TAU * j as f32 / segments as f32);
+        Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+    };
+    let mut triangles = Vec::new();
+    for i in 0..rings {
+        for j in 0..segments {
+            let [a, b, c, d] = [point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)];
+            // Outward: (b − a) × (c − a) points away from the centre
+            triangles
+                .extend([[a, c, b], [a, d, c]].into_iter().filter(|[a, b, c]| (*b - *a).cross(*c - *a).length() > 0.0));
+        }
+    }
+    let mut tessellated = scene.clone();
+    tessellated.meshes.insert("sphere.obj".into(), Arc::new(gi_studio::scene::mesh::MeshData::new(triangles)));
+    tessellated.objects[ball].shape =
+        Shape::Mesh { file: "sphere.obj".into(), translate: center, scale: radius, rotate_degrees: Vec3::ZERO };
+    let mut bare = scene.clone();
+    bare.objects.remove(ball);
+    let settings = common::settings(Algorithm::Path, 96, 72, 64);
+    let mean =
+        |scene: &gi_studio::scene::Scene| common::mean_luminance(&common::render(scene, settings.clone()).0.pixels);
+    let (analytic, mesh, without) = (mean(&scene), mean(&tessellated), mean(&bare));
+    println!("mean luminance: analytic {analytic}, tessellated {mesh}, without the ball {without}");
+    assert!((mesh / analytic - 1.0).abs() < 0.001, "tessellated {mesh} against analytic {analytic}");
+    assert!((without / analytic - 1.0).abs() > 0.02, "the ball barely shows: {without} against {analytic}");
+}

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use std::sync::Arc;
 
-use super::mesh::{load_mesh, MeshError, Meshes};
+use super::mesh::{builtin_mesh, is_builtin, load_mesh, MeshError, Meshes};
 use super::{Invalid, Scene, Shape, ValidScene};
 use crate::fileio::{self, FileError};
 use crate::limits;
@@ -72,12 +72,13 @@ pub fn parse_scene_with(text: &str, path: &Path, loaded: &Meshes) -> Result<Vali
 /// (or take it from `loaded`), within `limits::MESH_TRIANGLES` all told.
 /// Once read, a mesh is named by its full path: the scene can be saved in
 /// any folder, and its autosave restored from anywhere (`save_scene`
-/// writes the name relative again where it can).
+/// writes the name relative again where it can). A built-in mesh keeps
+/// its name.
 fn load_meshes(scene: &mut Scene, text: &str, path: &Path, loaded: &Meshes) -> Result<(), SceneFileError> {
     let folder = folder_of(path);
     for index in 0..scene.objects.len() {
         let Shape::Mesh { file, .. } = &mut scene.objects[index].shape else { continue };
-        if let Some(full) = folder.join(&*file).to_str() {
+        if let Some(full) = folder.join(&*file).to_str().filter(|_| !is_builtin(file)) {
             *file = full.to_owned();
         }
         let file = file.clone();
@@ -86,6 +87,7 @@ fn load_meshes(scene: &mut Scene, text: &str, path: &Path, loaded: &Meshes) -> R
         }
         let mesh = match loaded.get(&file) {
             Some(mesh) => Ok(mesh.clone()),
+            None if is_builtin(&file) => builtin_mesh(&file).map(Arc::new),
             None => load_mesh(&folder.join(&file)).map(Arc::new),
         };
         let mesh = mesh.and_then(|mesh| match scene.meshes.triangles() + mesh.triangles.len() {
@@ -116,6 +118,9 @@ pub fn save_scene(scene: &Scene, path: &Path) -> Result<(), SceneFileError> {
     let mut written = scene.clone();
     for object in &mut written.objects {
         let Shape::Mesh { file, .. } = &mut object.shape else { continue };
+        if is_builtin(file) {
+            continue;
+        }
         let full = folder.join(&*file);
         if let Some(inside) = full.strip_prefix(&folder).ok().and_then(Path::to_str) {
             *file = inside.to_owned();

@@ -3,7 +3,9 @@
 //! is the scene's) and PLY (ASCII and binary of either byte order, faces
 //! in `vertex_indices` or `vertex_index`, through `ply-rs-bw`). What is
 //! read is bounded by `limits`: the file's size first, then the counts a
-//! PLY header declares against what that size can hold.
+//! PLY header declares against what that size can hold. The meshes the
+//! built-in scenes use are compiled in and named `builtin:` and their file's
+//! name, so that those scenes open, and save, anywhere.
 
 use std::collections::BTreeMap;
 use std::io::{BufReader, Cursor};
@@ -46,6 +48,30 @@ pub enum MeshError {
     Empty { path: PathBuf },
     #[error("{path}: \"{extension}\" is not a mesh file this reads (.obj or .ply)")]
     Kind { path: PathBuf, extension: String },
+    #[error("\"{name}\" is not a built-in mesh (those are {})", builtin_names().collect::<Vec<_>>().join(", "))]
+    NotBuiltIn { name: String },
+}
+
+/// What names a compiled-in mesh rather than a file.
+pub const BUILTIN: &str = "builtin:";
+
+/// (file name, bytes) of the meshes the built-in scenes use, written by
+/// `assets/meshes/make_meshes.py`.
+const BUILTIN_MESHES: &[(&str, &[u8])] = &[
+    ("cornell-white.obj", include_bytes!("../../assets/meshes/cornell-white.obj")),
+    ("cornell-red.obj", include_bytes!("../../assets/meshes/cornell-red.obj")),
+    ("cornell-green.obj", include_bytes!("../../assets/meshes/cornell-green.obj")),
+    ("torus-knot.ply", include_bytes!("../../assets/meshes/torus-knot.ply")),
+];
+
+/// Every built-in mesh's name as a scene writes it (`builtin:torus-knot.ply`).
+pub fn builtin_names() -> impl Iterator<Item = String> {
+    BUILTIN_MESHES.iter().map(|(name, _)| format!("{BUILTIN}{name}"))
+}
+
+/// Whether a scene's `file` names a compiled-in mesh.
+pub fn is_builtin(file: &str) -> bool {
+    file.starts_with(BUILTIN)
 }
 
 /// The meshes a scene's objects name, loaded, by the name as written.
@@ -82,15 +108,36 @@ impl Meshes {
 
 /// The mesh in `path`, by its extension.
 pub fn load_mesh(path: &Path) -> Result<MeshData, MeshError> {
-    let extension = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let extension = extension_of(path);
     let bytes = match extension.as_str() {
         "obj" | "ply" => fileio::read_bounded(path, limits::MESH_FILE_BYTES)?,
         _ => return Err(MeshError::Kind { path: path.to_owned(), extension }),
     };
+    read_mesh(&bytes, &extension, path)
+}
+
+/// The compiled-in mesh a scene names `builtin:name`.
+pub fn builtin_mesh(file: &str) -> Result<MeshData, MeshError> {
+    let name = file.strip_prefix(BUILTIN).unwrap_or(file);
+    let Some((_, bytes)) = BUILTIN_MESHES.iter().find(|(n, _)| *n == name) else {
+        return Err(MeshError::NotBuiltIn { name: file.to_owned() });
+    };
+    let path = Path::new(file);
+    read_mesh(bytes, &extension_of(path), path)
+}
+
+fn extension_of(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+/// A mesh from its file's bytes, read by the format `extension` names;
+/// `path` names it in errors.
+fn read_mesh(bytes: &[u8], extension: &str, path: &Path) -> Result<MeshData, MeshError> {
     let format = |message: String| MeshError::Format { path: path.to_owned(), message };
-    let triangles = match extension.as_str() {
-        "obj" => obj_triangles(&bytes).map_err(format)?,
-        _ => ply_triangles(&bytes).map_err(format)?,
+    let triangles = match extension {
+        "obj" => obj_triangles(bytes).map_err(format)?,
+        "ply" => ply_triangles(bytes).map_err(format)?,
+        _ => return Err(MeshError::Kind { path: path.to_owned(), extension: extension.to_owned() }),
     };
     match triangles.len() {
         0 => Err(MeshError::Empty { path: path.to_owned() }),

@@ -16,6 +16,8 @@ pub const PRESETS: &[(&str, &str)] = &[
     ("gap-room", include_str!("../../assets/scenes/gap-room.ron")),
     ("glossy", include_str!("../../assets/scenes/glossy.ron")),
     ("metals", include_str!("../../assets/scenes/metals.ron")),
+    ("cornell-mesh", include_str!("../../assets/scenes/cornell-mesh.ron")),
+    ("knot", include_str!("../../assets/scenes/knot.ron")),
 ];
 
 pub fn names() -> impl Iterator<Item = &'static str> {

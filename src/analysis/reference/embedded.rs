@@ -52,6 +52,16 @@ const EMBEDDED: &[(&str, &[u8], &str)] = &[
         include_bytes!("../../../assets/references/metals.exr"),
         include_str!("../../../assets/references/metals.exr.meta.ron"),
     ),
+    (
+        "cornell-mesh",
+        include_bytes!("../../../assets/references/cornell-mesh.exr"),
+        include_str!("../../../assets/references/cornell-mesh.exr.meta.ron"),
+    ),
+    (
+        "knot",
+        include_bytes!("../../../assets/references/knot.exr"),
+        include_str!("../../../assets/references/knot.exr.meta.ron"),
+    ),
 ];
 
 /// The compiled-in reference of `scene`, if it is a preset as shipped.
