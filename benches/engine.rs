@@ -1,5 +1,5 @@
 //! Engine speed: ray–sphere intersections per second, nearest hits on a
-//! quarter-million-triangle mesh, shadow rays one and
+//! quarter-million-triangle mesh, worlds compiled, shadow rays one and
 //! eight at a time, and path-traced samples per second on every preset at
 //! 512×384 (run with `cargo bench`).
 
@@ -81,6 +81,33 @@ fn mesh_rays(c: &mut Criterion) {
     group.bench_function("mesh_262k_triangles_nearest_hits", |b| {
         b.iter(|| rays.iter().filter(|ray| world.intersect(black_box(ray), f32::INFINITY).is_some()).count())
     });
+    group.finish();
+}
+
+/// Compiling a scene's world: the knot preset's (36,864 triangles) with
+/// its triangles built, and with them shared by a world still held (what
+/// the studio does at each edit that leaves the triangles alone); and a
+/// world of a million triangles (the blob of `rings` 512), built.
+fn world_builds(c: &mut Criterion) {
+    use gi_studio::render::world::World;
+    use gi_studio::scene::mesh::MeshData;
+    use gi_studio::scene::{Object, Shape, ValidScene};
+    let knot = presets::preset("knot").unwrap().unwrap();
+    let mut group = c.benchmark_group("world");
+    group.sample_size(10);
+    group.bench_function("knot_built", |b| b.iter(|| World::new(black_box(&knot)).lights.len()));
+    let held = World::new(&knot);
+    group.bench_function("knot_shared", |b| b.iter(|| World::new(black_box(&knot)).lights.len()));
+    drop(held);
+    let mut scene = presets::preset("thesis").unwrap().unwrap().into_scene();
+    scene.objects = vec![Object {
+        name: "blob".into(),
+        shape: Shape::Mesh { file: "blob".into(), translate: Vec3::ZERO, scale: 1.0, rotate_degrees: Vec3::ZERO },
+        material: scene.materials[0].name.clone(),
+    }];
+    scene.meshes.insert("blob".into(), Arc::new(MeshData::new(blob(512))));
+    let million = ValidScene::new(scene).expect("the blob's scene");
+    group.bench_function("blob_1m_triangles_built", |b| b.iter(|| World::new(black_box(&million)).lights.len()));
     group.finish();
 }
 
@@ -215,5 +242,14 @@ fn shadow_rays(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, ray_sphere, mesh_rays, shadow_rays, path_presets, whitted_cornell, sppm_caustics);
+criterion_group!(
+    benches,
+    ray_sphere,
+    mesh_rays,
+    world_builds,
+    shadow_rays,
+    path_presets,
+    whitted_cornell,
+    sppm_caustics
+);
 criterion_main!(benches);

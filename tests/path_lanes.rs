@@ -253,7 +253,7 @@ fn cornell_of_facets() -> Scene {
 fn triangles_found_through_the_hierarchy_bit_for_bit() {
     let scene = cornell_of_facets();
     let (world, _) = world(&scene, 40, 30);
-    assert!(world.shapes.triangles.len() > gi_studio::render::world::shapes::GROUPED_TRIANGLES);
+    assert!(world.shapes.triangles.list.len() > gi_studio::render::world::shapes::GROUPED_TRIANGLES);
     let lit = assert_lanes_match_scalar(&scene, 32, 2);
     assert!(lit > 1500, "only {lit} samples carried light");
 }

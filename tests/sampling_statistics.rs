@@ -137,7 +137,7 @@ fn light_pdf_toward(light: &LightSource, world: &World, at: Vec3, d: Vec3) -> f6
             f32::INFINITY,
         ),
         gi_studio::render::world::ShapeRef::Triangle(t) => {
-            intersect_triangle(&ray, &world.shapes.triangles[t as usize].0, f32::INFINITY)
+            intersect_triangle(&ray, &world.shapes.triangles.list[t as usize].0, f32::INFINITY)
         }
         gi_studio::render::world::ShapeRef::Plane(_) | gi_studio::render::world::ShapeRef::Mesh { .. } => None,
     };

@@ -181,9 +181,10 @@ impl World {
                 _ => None,
             })
             .collect();
-        world.light_plane = (world.shapes.triangles.iter())
+        let triangles = &world.shapes.triangles.list;
+        world.light_plane = (triangles.iter())
             .map(|(t, _)| {
-                let holds = |&j: &u32| world.shapes.triangles[j as usize].0.holds_in_plane(t);
+                let holds = |&j: &u32| triangles[j as usize].0.holds_in_plane(t);
                 light_triangles.iter().copied().find(holds).unwrap_or(u32::MAX)
             })
             .collect();

@@ -510,7 +510,7 @@ mod tests {
                         }
                         assert!(everything, "{name}: skipping found a blocker testing everything did not");
                         let own_plane = sample.on_triangle.is_some_and(|t| {
-                            w.shapes.triangles.iter().zip(&w.light_plane).any(|((triangle, _), plane)| {
+                            w.shapes.triangles.list.iter().zip(&w.light_plane).any(|((triangle, _), plane)| {
                                 *plane == w.light_plane[t as usize]
                                     && intersect_triangle(shadow, triangle, t_max).is_some()
                             })

@@ -133,10 +133,10 @@ impl LaneWorld {
             (V8::splat(Vec3::ZERO), V8::splat(Vec3::Z), F8::splat(0.0));
         let mut crossing = RunCrossing::new();
         // Through the hierarchy, lane by lane, where there is one
-        if let Some(tree) = &self.triangle_tree {
+        if let Some(tree) = &self.triangles.tree {
             for lane in active.lanes() {
                 let ray = Ray::new(origin.lane(lane), direction.lane(lane));
-                let triangle = |i: u32| &self.triangles[i as usize];
+                let triangle = |i: u32| &self.triangles.list[i as usize].0;
                 if let Some((j, _, hit)) = tree.nearest(triangle, &ray, t_hit.lane(lane)) {
                     t_hit.set_lane(lane, hit.t);
                     index.set_lane(lane, first_triangle + j as f32);
@@ -146,8 +146,8 @@ impl LaneWorld {
                 }
             }
         }
-        let grouped = if self.triangle_tree.is_some() { &[][..] } else { &self.triangles[..] };
-        for (j, triangle) in grouped.iter().enumerate() {
+        let grouped = if self.triangles.tree.is_some() { &[][..] } else { &self.triangles.list[..] };
+        for (j, (triangle, _)) in grouped.iter().enumerate() {
             let (near, sure) = Self::cull(&self.triangle_culls[j], &mut crossing, active, origin, direction, t_hit);
             if sure.any() {
                 let (point, error) = triangle.cull.plane.hit_point(origin, direction, crossing.at.t);

@@ -35,11 +35,10 @@ pub(crate) use shadows::Skips;
 use wall_exits::WallExits;
 
 use crate::geometry::sphere::{wall_slack, AnchoredSphere};
-use crate::geometry::Triangle;
 use crate::render::world::lanes::{self, Column, Column3, Index8, F8, LANES, M8, V8};
 use crate::render::world::light::{self, Emitter, LightSource};
 pub(crate) use crate::render::world::materials::lanes::{LaneSurfaces, MaterialTable, Scattered};
-use crate::render::world::shapes::{sphere::Sphere, ShapeIndex, TriangleTree};
+use crate::render::world::shapes::{sphere::Sphere, ShapeIndex, TriangleSet};
 use crate::render::world::{ShapeRef, World};
 use crate::scene::Rgb;
 
@@ -128,14 +127,14 @@ pub struct LaneWorld {
     /// the first plane).
     plane_normals: Column3,
     plane_offsets: Column,
-    triangles: Vec<Triangle>,
+    /// The world's triangles, and its hierarchy over them where it has
+    /// one: each lane's ray finds its triangle through it, as the scalar
+    /// code does.
+    triangles: Arc<TriangleSet>,
     /// What the cull reads of each triangle, in one record: one load
     /// where the triangle and a list of runs beside it took several, each
     /// with its bounds check.
     triangle_culls: Vec<LaneCull>,
-    /// The world's hierarchy over its triangles, where it has one: each
-    /// lane's ray finds its triangle through it, as the scalar code does.
-    triangle_tree: Option<Arc<TriangleTree>>,
     /// Each triangle's light plane (`World::light_plane`): a shadow ray
     /// toward a light on a triangle skips the triangles of its plane.
     triangle_planes: Vec<u32>,
@@ -233,13 +232,12 @@ impl LaneWorld {
             plane_normals: Column3::new(by_shape().map(|p| p.map_or(Vec3::ZERO, |p| p.normal))),
             plane_offsets: Column::new(by_shape().map(|p| p.map_or(0.0, |p| p.offset))),
             planes,
-            triangles: world.shapes.triangles.iter().map(|(triangle, _)| *triangle).collect(),
+            triangles: world.shapes.triangles.clone(),
             // A hierarchy's triangles are never culled in the lanes
-            triangle_culls: match world.shapes.triangle_tree {
+            triangle_culls: match world.shapes.triangles.tree {
                 Some(_) => Vec::new(),
-                None => lane_culls(&world.shapes.triangles),
+                None => lane_culls(&world.shapes.triangles.list),
             },
-            triangle_tree: world.shapes.triangle_tree.clone(),
             triangle_planes: world.light_plane.clone(),
             surfaces,
             lights: LaneLights::new(world),

@@ -59,22 +59,22 @@ impl LaneWorld {
         // the light triangle a ray ends on
         let mut crossing = RunCrossing::new();
         // Through the hierarchy, lane by lane, where there is one
-        if let Some(tree) = &self.triangle_tree {
+        if let Some(tree) = &self.triangles.tree {
             for lane in mask.and_not(blocked).lanes() {
                 let ray = Ray::new(origin.lane(lane), direction.lane(lane));
                 let skip = match skips {
                     Skips::All { plane, .. } => *plane,
                     Skips::Lanes { planes, .. } => planes[lane],
                 };
-                let triangle = |i: u32| &self.triangles[i as usize];
+                let triangle = |i: u32| &self.triangles.list[i as usize].0;
                 let aimed_at = |i: u32| skip == Some(self.triangle_planes[i as usize]);
                 if tree.any_hit(triangle, &ray, t_max.lane(lane), aimed_at) {
                     blocked.set(lane, true);
                 }
             }
         }
-        let grouped = if self.triangle_tree.is_some() { &[][..] } else { &self.triangles[..] };
-        for (j, (triangle, plane)) in grouped.iter().zip(&self.triangle_planes).enumerate() {
+        let grouped = if self.triangles.tree.is_some() { &[][..] } else { &self.triangles.list[..] };
+        for (j, ((triangle, _), plane)) in grouped.iter().zip(&self.triangle_planes).enumerate() {
             let aimed_at = match skips {
                 Skips::All { plane: skip, .. } if *skip == Some(*plane) => continue,
                 Skips::All { .. } => M8::NONE,

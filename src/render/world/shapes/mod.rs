@@ -5,13 +5,15 @@
 //! - `plane`: infinite planes (found by rays, never sampled);
 //! - `triangle`: triangles four to a SIMD group behind a test of where the
 //!   ray crosses their plane;
-//! - `mesh_light`: a mesh's triangles as one light.
+//! - `mesh_light`: a mesh's triangles as one light;
+//! - `triangle_set`: the triangles compiled, shared by worlds of the same ones.
 
 pub mod bvh;
 pub mod mesh_light;
 pub mod plane;
 pub mod sphere;
 pub mod triangle;
+pub mod triangle_set;
 pub mod triangle_tree;
 
 use std::sync::Arc;
@@ -27,6 +29,7 @@ pub use plane::PlaneShape;
 use sphere::Sphere;
 pub use sphere::{CappedSphere, EmitterCap, SphereLanes, SphereReach, Spheres};
 pub use triangle::TriangleLanes;
+pub use triangle_set::{TriangleSet, TriangleSource};
 pub use triangle_tree::TriangleTree;
 
 /// What a shape that can be an area light answers, written once per kind;
@@ -131,12 +134,7 @@ impl Emitter {
 pub struct Shapes {
     pub spheres: Spheres,
     pub planes: Vec<PlaneShape>,
-    pub triangles: Vec<(Triangle, u32)>,
-    /// The same triangles four to a SIMD group, for the hit loops, in a
-    /// scene of a few of them.
-    pub(crate) triangle_lanes: TriangleLanes,
-    /// A hierarchy over them, for a scene of many (`GROUPED_TRIANGLES`).
-    pub(crate) triangle_tree: Option<Arc<TriangleTree>>,
+    pub triangles: Arc<TriangleSet>,
 }
 
 /// Up to how many triangles a ray tests them all, four at a time, rather
@@ -165,7 +163,10 @@ impl Shapes {
     /// Of the objects' `shapes` (in order, the object's index beside each),
     /// and where each one went.
     pub fn new<'s>(shapes: impl Iterator<Item = (&'s Shape, u32)>, meshes: &Meshes) -> (Self, Vec<ShapeRef>) {
-        let (mut spheres, mut planes, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut spheres, mut planes, mut sources) = (Vec::new(), Vec::new(), Vec::new());
+        // Each source's mesh triangles as its file gives them (none for a triangle)
+        let mut files: Vec<&[[Vec3; 3]]> = Vec::new();
+        let mut triangles = 0;
         let refs = shapes
             .map(|(shape, object)| match *shape {
                 Shape::Sphere { center, radius } => {
@@ -178,38 +179,44 @@ impl Shapes {
                     ShapeRef::Plane(planes.len() as u32 - 1)
                 }
                 Shape::Triangle { a, b, c } => {
-                    triangles.push((Triangle::new(a, b, c), object));
-                    ShapeRef::Triangle(triangles.len() as u32 - 1)
+                    sources.push(TriangleSource::triangle([a, b, c], object));
+                    files.push(&[]);
+                    triangles += 1;
+                    ShapeRef::Triangle(triangles - 1)
                 }
                 Shape::Mesh { ref file, .. } => {
                     // A valid scene has every mesh it names loaded
-                    let first = triangles.len() as u32;
                     let loaded = meshes.get(file).map_or(&[][..], |mesh| &mesh.triangles[..]);
-                    let placement = shape.placement();
-                    let placed = |t: &[Vec3; 3]| {
-                        let [a, b, c] = t.map(|v| placement.transform_point3(v));
-                        Triangle::new(a, b, c)
-                    };
-                    triangles.extend(loaded.iter().map(|t| (placed(t), object)));
-                    ShapeRef::Mesh { first, count: triangles.len() as u32 - first }
+                    let key = meshes.get(file).map_or(0, |mesh| mesh.key);
+                    let (count, placement) = (loaded.len(), shape.placement());
+                    sources.push(TriangleSource::mesh(key, count, placement, object));
+                    files.push(loaded);
+                    let first = triangles;
+                    triangles += count as u32;
+                    ShapeRef::Mesh { first, count: count as u32 }
                 }
             })
             .collect();
-        Triangle::share_planes(&mut triangles.iter_mut().map(|(triangle, _)| triangle).collect::<Vec<_>>());
-        let (triangle_lanes, triangle_tree) = match triangles.len() > GROUPED_TRIANGLES {
-            true => (TriangleLanes::default(), Some(Arc::new(TriangleTree::new(&triangles)))),
-            false => (TriangleLanes::new(&triangles), None),
+        let list = || {
+            let mut list = Vec::with_capacity(triangles as usize);
+            for (source, file) in sources.iter().zip(&files) {
+                let object = source.object();
+                list.extend(source.triangles(file).map(|[a, b, c]| (Triangle::new(a, b, c), object)));
+            }
+            list
         };
-        (Shapes { spheres: Spheres::new(spheres), planes, triangles, triangle_lanes, triangle_tree }, refs)
+        let triangles = TriangleSet::shared(&sources, list);
+        (Shapes { spheres: Spheres::new(spheres), planes, triangles }, refs)
     }
 
     /// The nearest triangle on the ray within (0, t_max), its object and
     /// the hit: what `intersect_triangle` over the triangles finds.
     #[inline]
     pub fn nearest_triangle(&self, ray: &Ray, t_max: f32) -> Option<(u32, u32, SurfaceHit)> {
-        match &self.triangle_tree {
-            Some(tree) => tree.nearest(|i| &self.triangles[i as usize].0, ray, t_max),
-            None => self.triangle_lanes.nearest(&self.triangles, ray, t_max),
+        let set = &*self.triangles;
+        match &set.tree {
+            Some(tree) => tree.nearest(|i| &set.list[i as usize].0, ray, t_max),
+            None => set.lanes.nearest(&set.list, ray, t_max),
         }
     }
 
@@ -217,16 +224,17 @@ impl Shapes {
     /// (0, t_max).
     #[inline]
     pub fn any_triangle(&self, ray: &Ray, t_max: f32, skip: impl Fn(u32) -> bool) -> bool {
-        match &self.triangle_tree {
-            Some(tree) => tree.any_hit(|i| &self.triangles[i as usize].0, ray, t_max, skip),
-            None => self.triangle_lanes.any_hit(&self.triangles, ray, t_max, skip),
+        let set = &*self.triangles;
+        match &set.tree {
+            Some(tree) => tree.any_hit(|i| &set.list[i as usize].0, ray, t_max, skip),
+            None => set.lanes.any_hit(&set.list, ray, t_max, skip),
         }
     }
 
     /// The box about every finite shape (`None` without any): (low, high).
     pub fn finite_box(&self) -> Option<(Vec3, Vec3)> {
         let spheres = self.spheres.list.iter().map(|s| (s.center - s.radius, s.center + s.radius));
-        let (lo, hi) = (spheres.chain(triangle_boxes(&self.triangles)))
+        let (lo, hi) = (spheres.chain(triangle_boxes(&self.triangles.list)))
             .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (l, h)| (lo.min(l), hi.max(h)));
         (lo.x <= hi.x).then_some((lo, hi))
     }
@@ -240,12 +248,12 @@ impl Shapes {
                 Some(Emitter::Sphere { sphere: i, shape: CappedSphere { center, radius, cap: EmitterCap::WHOLE } })
             }
             ShapeRef::Triangle(t) => {
-                let triangle = self.triangles[t as usize].0;
+                let triangle = self.triangles.list[t as usize].0;
                 (!triangle.is_degenerate()).then_some(Emitter::Triangle { triangle: t, shape: triangle })
             }
             ShapeRef::Mesh { first, count } => {
                 let triangles: Vec<Triangle> =
-                    self.triangles[first as usize..(first + count) as usize].iter().map(|(t, _)| *t).collect();
+                    self.triangles.list[first as usize..(first + count) as usize].iter().map(|(t, _)| *t).collect();
                 MeshEmitter::new(&triangles).map(|mesh| Emitter::Mesh(Arc::new(mesh)))
             }
             ShapeRef::Plane(_) => None,
@@ -257,13 +265,13 @@ impl Shapes {
         match shape {
             ShapeRef::Sphere(i) => Some((self.spheres.center(i as usize), self.spheres.radius(i as usize))),
             ShapeRef::Triangle(t) => {
-                let [a, b, c] = self.triangles[t as usize].0.vertices;
+                let [a, b, c] = self.triangles.list[t as usize].0.vertices;
                 let center = (a + b + c) / 3.0;
                 let radius = (a - center).length().max((b - center).length()).max((c - center).length());
                 Some((center, radius * 1.001))
             }
             ShapeRef::Mesh { first, count } => {
-                let triangles = &self.triangles[first as usize..(first + count) as usize];
+                let triangles = &self.triangles.list[first as usize..(first + count) as usize];
                 let (lo, hi) = (triangle_boxes(triangles).into_iter())
                     .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (l, h)| (lo.min(l), hi.max(h)));
                 (lo.x <= hi.x).then(|| ((lo + hi) * 0.5, (hi - lo).length() * 0.5 * 1.001))
@@ -282,7 +290,7 @@ impl Shapes {
     pub fn objects(&self) -> impl Iterator<Item = u32> + '_ {
         let spheres = self.spheres.list.iter().map(|sphere| sphere.object);
         let planes = self.planes.iter().map(|plane| plane.object);
-        spheres.chain(planes).chain(self.triangles.iter().map(|(_, object)| *object))
+        spheres.chain(planes).chain(self.triangles.list.iter().map(|(_, object)| *object))
     }
 }
 
