@@ -5,7 +5,7 @@
 //! camera moved, a colour changed, a sphere added after them) now finds
 //! the set already built, where each world built its own hierarchy again.
 
-use std::sync::{Arc, Mutex, Weak};
+use std::sync::{Arc, Mutex, OnceLock, Weak};
 
 use glam::{Affine3A, Vec3};
 
@@ -75,8 +75,12 @@ impl TriangleSource {
     }
 }
 
-/// The sets built so far that some world still holds.
-static BUILT: Mutex<Vec<(Vec<TriangleSource>, Weak<TriangleSet>)>> = Mutex::new(Vec::new());
+/// A set being built or built: those waiting for it wait on the lock,
+/// which then holds it as long as some world does.
+type Slot = Arc<OnceLock<Weak<TriangleSet>>>;
+
+/// The sets built or being built, by what makes them.
+static BUILT: Mutex<Vec<(Vec<TriangleSource>, Slot)>> = Mutex::new(Vec::new());
 
 impl TriangleSet {
     /// The set of `list` (the triangles `sources` make), with their planes
@@ -92,30 +96,38 @@ impl TriangleSet {
     }
 
     /// The set `sources` make: one a world still holds if there is one,
-    /// else `list()`'s, built here (outside the lock: worlds of other
-    /// triangles are not kept waiting) and kept for the next world.
-    pub fn shared(sources: &[TriangleSource], list: impl FnOnce() -> Vec<(Triangle, u32)>) -> Arc<Self> {
+    /// or the one another thread is building (waited for: the studio's
+    /// panes and its picking ask for the same set at once, and built it
+    /// once each), else `list()`'s, built here and kept for the next world.
+    pub fn shared(sources: &[TriangleSource], list: impl Fn() -> Vec<(Triangle, u32)>) -> Arc<Self> {
         // An empty set is not worth a lookup
         if sources.is_empty() {
             return Arc::new(TriangleSet::default());
         }
-        if let Some(set) = Self::find(sources) {
-            return set;
-        }
-        let set = Arc::new(TriangleSet::new(list()));
-        let mut built = BUILT.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        built.retain(|(_, set)| set.strong_count() > 0);
-        // Built meanwhile by another world's thread: the first one stays
-        if let Some(first) = built.iter().find(|(s, _)| *s == sources).and_then(|(_, set)| set.upgrade()) {
-            return first;
-        }
-        built.push((sources.to_vec(), Arc::downgrade(&set)));
-        set
-    }
-
-    fn find(sources: &[TriangleSource]) -> Option<Arc<Self>> {
-        let built = BUILT.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        built.iter().find(|(s, _)| s == sources).and_then(|(_, set)| set.upgrade())
+        let slot = {
+            let mut built = BUILT.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            // Those built and no longer held go; those being built stay
+            built.retain(|(_, slot)| slot.get().is_none_or(|set| set.strong_count() > 0));
+            match built.iter().find(|(s, _)| s == sources) {
+                Some((_, slot)) => slot.clone(),
+                None => {
+                    let slot = Slot::default();
+                    built.push((sources.to_vec(), slot.clone()));
+                    slot
+                }
+            }
+        };
+        // Outside the lock: worlds of other triangles are not kept waiting
+        let mut mine = None;
+        let set = slot.get_or_init(|| {
+            let set = Arc::new(TriangleSet::new(list()));
+            let held = Arc::downgrade(&set);
+            mine = Some(set);
+            held
+        });
+        // Built by this thread, or still held by another's world; or, rarely,
+        // let go between the lookup and here: built again, not kept
+        mine.or_else(|| set.upgrade()).unwrap_or_else(|| Arc::new(TriangleSet::new(list())))
     }
 }
 
@@ -164,5 +176,25 @@ mod tests {
                 assert!(!Arc::ptr_eq(&first.shapes.triangles, &other.shapes.triangles), "{name}: {what} shared");
             }
         }
+    }
+
+    /// Threads asking for the same new set at once (the studio's panes
+    /// after an edit) wait for one build and share it.
+    #[test]
+    fn a_set_asked_for_at_once_is_built_once() {
+        let builds = std::sync::atomic::AtomicUsize::new(0);
+        let sources = [TriangleSource::triangle([glam::Vec3::X, glam::Vec3::Y, glam::Vec3::Z * 7.25], 3)];
+        let list = || {
+            builds.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            // Long enough that the other threads ask while it is built
+            std::thread::sleep(std::time::Duration::from_millis(50));
+            vec![(Triangle::new(glam::Vec3::X, glam::Vec3::Y, glam::Vec3::Z * 7.25), 3)]
+        };
+        let sets: Vec<Arc<TriangleSet>> = std::thread::scope(|scope| {
+            let threads: Vec<_> = (0..4).map(|_| scope.spawn(|| TriangleSet::shared(&sources, list))).collect();
+            threads.into_iter().map(|t| t.join().expect("a thread")).collect()
+        });
+        assert_eq!(builds.into_inner(), 1);
+        assert!(sets.iter().all(|set| Arc::ptr_eq(set, &sets[0])));
     }
 }
