@@ -70,7 +70,7 @@ struct Node {
 /// Eight children's boxes side by side, tested against a ray four at a
 /// time (SSE, which every x86-64 has, where the scalar callers run): four
 /// cache lines.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 struct Wide {
     /// Per half (children 0–3, 4–7), per axis, each child's low and
@@ -100,10 +100,86 @@ pub struct Bvh {
     order: Vec<u32>,
 }
 
-/// The binary tree as the build makes it.
-struct Binary {
-    nodes: Vec<Node>,
-    order: Vec<u32>,
+/// What a build reads: the primitives' boxes and centres, and how it splits.
+struct Build<'a> {
+    bounds: &'a [Bounds],
+    centroids: &'a [Vec3],
+    together: usize,
+    median_depth: usize,
+}
+
+/// From how many primitives a node's two halves are built on two threads:
+/// below it a thread's share is too small to pay for the handing over.
+const PARALLEL: usize = 1 << 14;
+
+impl Build<'_> {
+    /// The binary tree over `order` (which starts at `first` of the whole
+    /// order), its root first and each inner node's two children side by
+    /// side. Large halves are built in parallel; the tree is the same on
+    /// any number of threads.
+    fn subtree(&self, order: &mut [u32], first: usize, depth: usize) -> Vec<Node> {
+        if order.len() < PARALLEL {
+            return self.sequential(order, first, depth);
+        }
+        let (lo, hi) = order.iter().fold(EMPTY, |b, &i| union(b, self.bounds[i as usize]));
+        let Some(middle) = self.split(order, (lo, hi), depth) else {
+            return vec![Node { lo, hi, start: first as u32, count: order.len() as u32 }];
+        };
+        let (left, right) = order.split_at_mut(middle);
+        let (left, right) =
+            rayon::join(|| self.subtree(left, first, depth + 1), || self.subtree(right, first + middle, depth + 1));
+        // [root, left's root, right's root, left's others, right's others]:
+        // each part's node k ≥ 1 moves by a fixed amount, and so do the
+        // children its inner nodes name (never a part's root)
+        let (left_moves, right_moves) = (2, left.len() + 1);
+        let moved = |node: &Node, by: usize| match node.count {
+            0 => Node { start: node.start + by as u32, ..*node },
+            _ => *node,
+        };
+        let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+        nodes.push(Node { lo, hi, start: 1, count: 0 });
+        nodes.push(moved(&left[0], left_moves));
+        nodes.push(moved(&right[0], right_moves));
+        nodes.extend(left[1..].iter().map(|node| moved(node, left_moves)));
+        nodes.extend(right[1..].iter().map(|node| moved(node, right_moves)));
+        nodes
+    }
+
+    /// `subtree` on one thread.
+    fn sequential(&self, order: &mut [u32], first: usize, depth: usize) -> Vec<Node> {
+        let mut nodes = Vec::with_capacity(2 * order.len());
+        nodes.push(Node { lo: Vec3::ZERO, hi: Vec3::ZERO, start: 0, count: 0 });
+        // (node, start, end, depth): ranges of `order` still to place
+        let mut todo = vec![(0usize, 0usize, order.len(), depth)];
+        while let Some((node, start, end, depth)) = todo.pop() {
+            let range = &mut order[start..end];
+            let (lo, hi) = range.iter().fold(EMPTY, |b, &i| union(b, self.bounds[i as usize]));
+            nodes[node].lo = lo;
+            nodes[node].hi = hi;
+            let Some(middle) = self.split(range, (lo, hi), depth) else {
+                nodes[node].start = (first + start) as u32;
+                nodes[node].count = (end - start) as u32;
+                continue;
+            };
+            let left = nodes.len();
+            nodes[node].start = left as u32;
+            nodes.push(Node { lo, hi, start: 0, count: 0 });
+            nodes.push(Node { lo, hi, start: 0, count: 0 });
+            todo.push((left, start, start + middle, depth + 1));
+            todo.push((left + 1, start + middle, end, depth + 1));
+        }
+        nodes
+    }
+
+    /// Where `range`, whose box is `node`, splits at `depth`: by the
+    /// heuristic above `median_depth`, at the median below; `None` for a leaf.
+    fn split(&self, range: &mut [u32], node: Bounds, depth: usize) -> Option<usize> {
+        match range.len() > LEAF {
+            true if depth < self.median_depth => Bvh::split(range, self.bounds, self.centroids, node, self.together),
+            true => Some(Bvh::median(range, self.centroids)),
+            false => None,
+        }
+    }
 }
 
 /// A box: (low corner, high corner).
@@ -131,38 +207,14 @@ impl Bvh {
 
     /// `new`, halving at the median from `median_depth` down.
     fn build(bounds: &[Bounds], together: usize, median_depth: usize) -> Self {
-        let together = together.max(1);
         if bounds.is_empty() {
             return Bvh::default();
         }
         let centroids: Vec<Vec3> = bounds.iter().map(|(lo, hi)| (*lo + *hi) * 0.5).collect();
-        let mut bvh = Binary { nodes: Vec::with_capacity(2 * bounds.len()), order: (0..bounds.len() as u32).collect() };
-        bvh.nodes.push(Node { lo: Vec3::ZERO, hi: Vec3::ZERO, start: 0, count: 0 });
-        // (node, first, end, depth): ranges of `order` still to place
-        let mut todo = vec![(0usize, 0usize, bounds.len(), 0usize)];
-        while let Some((node, first, end, depth)) = todo.pop() {
-            let range = &mut bvh.order[first..end];
-            let (lo, hi) = range.iter().fold(EMPTY, |b, &i| union(b, bounds[i as usize]));
-            bvh.nodes[node].lo = lo;
-            bvh.nodes[node].hi = hi;
-            let split = match range.len() > LEAF {
-                true if depth < median_depth => Self::split(range, bounds, &centroids, (lo, hi), together),
-                true => Some(Self::median(range, &centroids)),
-                false => None,
-            };
-            let Some(middle) = split else {
-                bvh.nodes[node].start = first as u32;
-                bvh.nodes[node].count = (end - first) as u32;
-                continue;
-            };
-            let left = bvh.nodes.len();
-            bvh.nodes[node].start = left as u32;
-            bvh.nodes.push(Node { lo, hi, start: 0, count: 0 });
-            bvh.nodes.push(Node { lo, hi, start: 0, count: 0 });
-            todo.push((left, first, first + middle, depth + 1));
-            todo.push((left + 1, first + middle, end, depth + 1));
-        }
-        Bvh { wide: Self::widen(&bvh.nodes), order: bvh.order }
+        let build = Build { bounds, centroids: &centroids, together: together.max(1), median_depth };
+        let mut order: Vec<u32> = (0..bounds.len() as u32).collect();
+        let nodes = build.subtree(&mut order, 0, 0);
+        Bvh { wide: Self::widen(&nodes), order }
     }
 
     /// Sorts `range` about the cheapest split by the heuristic and says
@@ -412,6 +464,14 @@ impl Bvh {
         false
     }
 
+    /// Each leaf's primitives, in the order `map_leaves` meets them.
+    pub fn leaves(&self) -> Vec<&[u32]> {
+        let children = self.wide.iter().flat_map(|node| (0..WIDTH).map(move |k| (node, k)));
+        (children.filter(|(node, k)| node.valid & (1 << k) != 0 && node.count[*k] != 0))
+            .map(|(node, k)| &self.order[node.start[k] as usize..][..node.count[k] as usize])
+            .collect()
+    }
+
     /// Renames every leaf: `rename` is given a leaf's primitives and
     /// answers with the (start, count) the leaf tests will be given in
     /// their place, the count no more than the primitives; a count of zero
@@ -598,6 +658,24 @@ mod tests {
         }
     }
 
+    /// Halves built on two threads make the tree one thread makes, node
+    /// for node, whatever the threads' timing.
+    #[test]
+    fn the_parallel_build_makes_the_tree_one_thread_makes() {
+        let mut s = Sampler::new(0, 0, 61);
+        let list = triangles(&mut s, 3 * PARALLEL);
+        let bounds = bounds_of(&list);
+        let centroids: Vec<Vec3> = bounds.iter().map(|(lo, hi)| (*lo + *hi) * 0.5).collect();
+        let build = Build { bounds: &bounds, centroids: &centroids, together: 4, median_depth: MEDIAN_DEPTH };
+        let mut parallel_order: Vec<u32> = (0..bounds.len() as u32).collect();
+        let mut sequential_order = parallel_order.clone();
+        let parallel = build.subtree(&mut parallel_order, 0, 0);
+        let sequential = build.sequential(&mut sequential_order, 0, 0);
+        assert_eq!(parallel_order, sequential_order);
+        assert!(Bvh::widen(&parallel) == Bvh::widen(&sequential), "the eight-wide trees differ");
+        assert_eq!(parallel.len(), sequential.len());
+    }
+
     /// Levels of eight-wide nodes below `node` (at most the binary tree's).
     fn depth(bvh: &Bvh, node: usize) -> usize {
         let wide = &bvh.wide[node];
@@ -607,7 +685,7 @@ mod tests {
 
     /// A node is four cache lines, and starts one.
     #[test]
-    fn a_node_is_two_cache_lines() {
+    fn a_node_is_four_cache_lines() {
         assert_eq!((std::mem::size_of::<Wide>(), std::mem::align_of::<Wide>()), (256, 64));
     }
 }

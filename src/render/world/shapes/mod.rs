@@ -200,8 +200,7 @@ impl Shapes {
         let list = || {
             let mut list = Vec::with_capacity(triangles as usize);
             for (source, file) in sources.iter().zip(&files) {
-                let object = source.object();
-                list.extend(source.triangles(file).map(|[a, b, c]| (Triangle::new(a, b, c), object)));
+                source.make_into(file, &mut list);
             }
             list
         };

@@ -26,7 +26,7 @@ use crate::render::world::sampling::uniform_triangle;
 /// the watertight test reads where the cull is not sure.
 #[derive(Clone, Debug)]
 #[repr(C, align(64))]
-struct Group {
+pub struct Group {
     normal: V3<Vec4>,
     offset: Vec4,
     scale: Vec4,
@@ -106,9 +106,26 @@ impl TriangleLanes {
     /// their order (degenerate triangles, which nothing hits, left out):
     /// the range of groups they take, as (first, count).
     pub fn push_run(&mut self, triangles: &[(Triangle, u32)], ids: &[u32]) -> (u32, u32) {
+        self.push_groups(Self::groups_of(triangles, ids))
+    }
+
+    /// `groups` after those already held: the range they take.
+    pub fn push_groups(&mut self, groups: Vec<Group>) -> (u32, u32) {
         let first = self.groups.len() as u32;
+        self.groups.extend(groups);
+        (first, self.groups.len() as u32 - first)
+    }
+
+    /// Room for `more` groups, asked for at once.
+    pub fn reserve_exact(&mut self, more: usize) {
+        self.groups.reserve_exact(more);
+    }
+
+    /// The groups of the triangles `ids` names, in their order, the
+    /// degenerate ones left out (`push_run`'s).
+    pub fn groups_of(triangles: &[(Triangle, u32)], ids: &[u32]) -> Vec<Group> {
         let kept: Vec<u32> = ids.iter().copied().filter(|&i| !triangles[i as usize].0.is_degenerate()).collect();
-        for chunk in kept.chunks(4) {
+        let group = |chunk: &[u32]| {
             // Empty lanes copy the last triangle and are masked off
             let id = |k: usize| chunk[k.min(chunk.len() - 1)];
             let lane = |k: usize| &triangles[id(k) as usize].0;
@@ -116,7 +133,7 @@ impl TriangleLanes {
             let point = |f: &dyn Fn(&Triangle) -> Vec3| V3::new(vec(&|t| f(t).x), vec(&|t| f(t).y), vec(&|t| f(t).z));
             let drops = |axis: usize| (0..4).filter(|&k| lane(k).cull.plane.drop == axis).map(|k| 1 << k).sum::<u32>();
             let edge = |e: usize, i: usize| vec(&|t| t.cull.edges.0[e][i]);
-            self.groups.push(Group {
+            Group {
                 normal: point(&|t| t.cull.plane.normal),
                 offset: vec(&|t| t.cull.plane.offset),
                 scale: vec(&|t| t.cull.plane.scale),
@@ -126,9 +143,9 @@ impl TriangleLanes {
                 lanes: drops(0) | drops(2) << 4 | ((1 << chunk.len()) - 1) << 8,
                 normals: point(&|t| t.normal),
                 vertices: [point(&|t| t.vertices[0]), point(&|t| t.vertices[1]), point(&|t| t.vertices[2])],
-            });
-        }
-        (first, self.groups.len() as u32 - first)
+            }
+        };
+        kept.chunks(4).map(group).collect()
     }
 
     /// Asks the memory for what the cull and a hit read of group `g` (all

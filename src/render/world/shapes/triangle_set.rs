@@ -8,6 +8,7 @@
 use std::sync::{Arc, Mutex, OnceLock, Weak};
 
 use glam::{Affine3A, Vec3};
+use rayon::prelude::*;
 
 use super::triangle::TriangleLanes;
 use super::triangle_tree::TriangleTree;
@@ -53,17 +54,22 @@ impl TriangleSource {
         TriangleSource::Mesh { key, triangles, placement: placement.to_cols_array().map(f32::to_bits), object }
     }
 
-    /// What the source names, placed: a triangle's corners, or a mesh's
-    /// triangles from its file (`file`) where the placement puts them.
-    pub fn triangles<'a>(&self, file: &'a [[Vec3; 3]]) -> Box<dyn Iterator<Item = [Vec3; 3]> + 'a> {
+    /// Appends to `list` the triangles the source makes: a triangle, or a
+    /// mesh's triangles from its file (`file`) where the placement puts
+    /// them (made on every thread: a million of them take a while).
+    pub fn make_into(&self, file: &[[Vec3; 3]], list: &mut Vec<(Triangle, u32)>) {
+        let object = self.object();
         match *self {
             TriangleSource::Triangle { vertices, .. } => {
                 let v = |k: usize| Vec3::from_array(std::array::from_fn(|i| f32::from_bits(vertices[3 * k + i])));
-                Box::new(std::iter::once([v(0), v(1), v(2)]))
+                list.push((Triangle::new(v(0), v(1), v(2)), object));
             }
             TriangleSource::Mesh { placement, .. } => {
                 let placement = Affine3A::from_cols_array(&placement.map(f32::from_bits));
-                Box::new(file.iter().map(move |t| t.map(|v| placement.transform_point3(v))))
+                list.par_extend(file.par_iter().map(|t| {
+                    let [a, b, c] = t.map(|v| placement.transform_point3(v));
+                    (Triangle::new(a, b, c), object)
+                }));
             }
         }
     }

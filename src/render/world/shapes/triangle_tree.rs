@@ -7,9 +7,10 @@
 //! triangles in the traversal's order finds, bit for bit.
 
 use glam::Vec4;
+use rayon::prelude::*;
 
 use super::bvh::Bvh;
-use super::triangle::TriangleLanes;
+use super::triangle::{Group, TriangleLanes};
 use super::triangle_boxes;
 use crate::geometry::{Ray, RayShear, SurfaceHit, Triangle};
 
@@ -23,8 +24,13 @@ pub struct TriangleTree {
 impl TriangleTree {
     pub fn new(triangles: &[(Triangle, u32)]) -> Self {
         let mut bvh = Bvh::new(&triangle_boxes(triangles), 4);
+        // Each leaf's groups made on any thread, then laid out in order
+        let runs: Vec<Vec<Group>> =
+            bvh.leaves().into_par_iter().map(|ids| TriangleLanes::groups_of(triangles, ids)).collect();
         let mut lanes = TriangleLanes::default();
-        bvh.map_leaves(|ids| lanes.push_run(triangles, ids));
+        lanes.reserve_exact(runs.iter().map(Vec::len).sum());
+        let mut runs = runs.into_iter();
+        bvh.map_leaves(|_| lanes.push_groups(runs.next().unwrap_or_default()));
         TriangleTree { bvh, lanes }
     }
 
