@@ -1087,12 +1087,15 @@ fn a_dropped_or_imported_mesh_joins_the_scene_in_view() {
         harness.input_mut().dropped_files.push(std::sync::Arc::new(Dropped(path.to_owned())));
         harness.run_steps(2);
     };
+    // Read on a thread of its own: the frames go on meanwhile
     drop(&mut harness, &broken);
+    step_until(&mut harness, |app| app.messages().error.is_some());
     assert_eq!(*harness.state().scene(), before);
     let error = harness.state().messages().error.clone().expect("an error is shown");
     assert!(error.contains("broken.ply") && error.contains("more than the file holds"), "{error}");
 
     drop(&mut harness, &cube);
+    step_until(&mut harness, |app| app.scene().objects.len() > before.objects.len());
     let objects = &harness.state().scene().objects;
     let added = objects.last().expect("an object");
     assert_eq!((objects.len(), added.name.as_str()), (before.objects.len() + 1, "cube"));
@@ -1116,7 +1119,7 @@ fn a_dropped_or_imported_mesh_joins_the_scene_in_view() {
     harness.run_steps(4);
     harness.get_by_label("Import mesh (OBJ, PLY)");
     answer_file_dialog(&mut harness, &cube, "Import");
-    assert!(matches!(harness.state().scene().objects.last().map(|o| &o.shape), Some(Shape::Mesh { .. })));
+    step_until(&mut harness, |app| matches!(app.scene().objects.last().map(|o| &o.shape), Some(Shape::Mesh { .. })));
 }
 
 /// A scene of many objects lists only the rows in view (a list of 100,000

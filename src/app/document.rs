@@ -10,7 +10,7 @@ use std::sync::Arc;
 use super::history::History;
 use crate::render::world::camera::CameraModel;
 use crate::render::world::World;
-use crate::scene::mesh::{load_mesh, MeshError};
+use crate::scene::mesh::MeshData;
 use crate::scene::presets::default_scene;
 use crate::scene::{load_scene, save_scene, to_ron, Invalid, Object, Scene, SceneFileError, Shape, ValidScene};
 use glam::Vec3;
@@ -96,11 +96,10 @@ impl Document {
         self.next_revision += 1;
     }
 
-    /// Add the mesh in `path` as an object, in view: on the surface at the
-    /// centre of the view, a quarter of its distance across. The scene is
-    /// untouched if the file does not read. Returns the object's index.
-    pub fn import_mesh(&mut self, path: &Path) -> Result<usize, MeshError> {
-        let mesh = load_mesh(path)?;
+    /// Add `mesh`, read from `path`, as an object, in view: on the surface
+    /// at the centre of the view, a quarter of its distance across.
+    /// Returns the object's index.
+    pub fn add_mesh(&mut self, path: &Path, mesh: MeshData) -> usize {
         // Its own full path: the scene finds it wherever the scene is saved
         let file = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_owned()).display().to_string();
         let (lo, hi) = (mesh.triangles.iter().flatten())
@@ -118,7 +117,7 @@ impl Document {
         let shape = Shape::Mesh { file, translate, scale, rotate_degrees: Vec3::ZERO };
         scene.objects.push(Object { name, shape, material });
         self.changed();
-        Ok(self.scene.objects.len() - 1)
+        self.scene.objects.len() - 1
     }
 
     pub fn path(&self) -> Option<&Path> {

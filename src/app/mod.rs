@@ -14,6 +14,7 @@ mod files;
 mod handles;
 mod history;
 mod image_view;
+mod imports;
 mod inspector;
 mod keys;
 mod menu;

@@ -17,6 +17,7 @@ use super::difference::Difference;
 use super::document::Document;
 use super::export::export_image;
 use super::files::DialogPurpose;
+use super::imports::Imports;
 use super::inspector::{inspector_ui, Selection};
 use super::keys::{input_commands, Gesture, WindowState};
 use super::menu::{menu_bar_ui, MenuView};
@@ -39,6 +40,8 @@ pub struct StudioApp {
     dialogs: Dialogs,
     capture: Capture,
     difference: Difference,
+    /// Meshes being read for File ▸ Import mesh and dropped files.
+    imports: Imports,
     shown: Shown,
     recent: Vec<PathBuf>,
     messages: Messages,
@@ -84,6 +87,7 @@ impl StudioApp {
                 Capture::headless(path, args.quit_after_passes, args.quit_after_seconds)
             }),
             difference: Difference::default(),
+            imports: Imports::default(),
             shown: Shown { plots: restored.show_plots, ..Shown::default() },
             recent: restored.recent,
             messages: Messages { error: error.or(workers_error), status: restored.notices.join("; ") },
@@ -117,13 +121,7 @@ impl StudioApp {
                 }
             }
             Command::Write(purpose, path) => self.write_chosen(purpose, path),
-            Command::ImportMesh(path) => match self.document.import_mesh(&path) {
-                Ok(object) => {
-                    self.selection = Selection::Object(object);
-                    self.messages.say(format!("Imported {}", path.display()));
-                }
-                Err(e) => self.messages.fail(e),
-            },
+            Command::ImportMesh(path) => self.imports.start(path, &self.ctx),
             Command::Undo => self.document.undo(),
             Command::Redo => self.document.redo(),
             Command::SetPanes(count) if count != self.panes.count() => {
@@ -253,6 +251,9 @@ impl StudioApp {
             menu_bar_ui(ui, &view, &mut commands);
         });
         self.messages.status_ui(ui);
+        if self.imports.is_reading() {
+            egui::Panel::bottom("imports").show(ui, |ui| ui.horizontal(|ui| self.imports.reading_ui(ui)));
+        }
         egui::Panel::bottom("reference").show(ui, |ui| self.references.reference_ui(ui));
         egui::Panel::left("inspector").resizable(true).default_size(330.0).show(ui, |ui| {
             let problems = self.document.problems().to_vec();
@@ -283,6 +284,7 @@ impl StudioApp {
         for command in commands {
             self.apply(command);
         }
+        self.add_imported();
         if let Some(index) = promoted {
             self.promote_pane(index);
         }
@@ -345,6 +347,19 @@ impl StudioApp {
             }
             self.quit_confirmed = true;
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+    }
+
+    /// The meshes read since the last frame join the scene, each selected.
+    fn add_imported(&mut self) {
+        for (path, read) in self.imports.finished() {
+            match read {
+                Ok(mesh) => {
+                    self.selection = Selection::Object(self.document.add_mesh(&path, mesh));
+                    self.messages.say(format!("Imported {}", path.display()));
+                }
+                Err(e) => self.messages.fail(e),
+            }
         }
     }
 
