@@ -5,6 +5,7 @@
 //! camera moved, a colour changed, a sphere added after them) now finds
 //! the set already built, where each world built its own hierarchy again.
 
+use std::cell::Cell;
 use std::sync::{Arc, Mutex, OnceLock, Weak};
 
 use glam::{Affine3A, Vec3};
@@ -88,6 +89,27 @@ type Slot = Arc<OnceLock<Weak<TriangleSet>>>;
 /// The sets built or being built, by what makes them.
 static BUILT: Mutex<Vec<(Vec<TriangleSource>, Slot)>> = Mutex::new(Vec::new());
 
+thread_local! {
+    /// Whether this thread is building a set (`shared`).
+    static BUILDING: Cell<bool> = const { Cell::new(false) };
+}
+
+/// This thread's building, until dropped (a panicking build too).
+struct Building;
+
+impl Building {
+    fn start() -> Self {
+        BUILDING.set(true);
+        Building
+    }
+}
+
+impl Drop for Building {
+    fn drop(&mut self) {
+        BUILDING.set(false);
+    }
+}
+
 impl TriangleSet {
     /// The set of `list` (the triangles `sources` make), with their planes
     /// shared where they lie in one.
@@ -106,9 +128,11 @@ impl TriangleSet {
     /// panes and its picking ask for the same set at once, and built it
     /// once each), else `list()`'s, built here and kept for the next world.
     pub fn shared(sources: &[TriangleSource], list: impl Fn() -> Vec<(Triangle, u32)>) -> Arc<Self> {
-        // An empty set is not worth a lookup
-        if sources.is_empty() {
-            return Arc::new(TriangleSet::default());
+        // An empty set is not worth a lookup; and a thread that is building
+        // a set, waiting in one of the build's parallel loops, may be handed
+        // another task that asks for a set: it must not wait for itself
+        if sources.is_empty() || BUILDING.get() {
+            return Arc::new(TriangleSet::new(list()));
         }
         let slot = {
             let mut built = BUILT.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
@@ -126,6 +150,7 @@ impl TriangleSet {
         // Outside the lock: worlds of other triangles are not kept waiting
         let mut mine = None;
         let set = slot.get_or_init(|| {
+            let _building = Building::start();
             let set = Arc::new(TriangleSet::new(list()));
             let held = Arc::downgrade(&set);
             mine = Some(set);
@@ -202,5 +227,19 @@ mod tests {
         });
         assert_eq!(builds.into_inner(), 1);
         assert!(sets.iter().all(|set| Arc::ptr_eq(set, &sets[0])));
+    }
+
+    /// A thread building a set may be handed, inside the build's parallel
+    /// loops, a task that asks for the same set: it builds its own rather
+    /// than wait for itself (which never ends).
+    #[test]
+    fn a_thread_building_a_set_does_not_wait_for_itself() {
+        let sources = [TriangleSource::triangle([glam::Vec3::X, glam::Vec3::Y, glam::Vec3::Z * 9.5], 1)];
+        let plain = || vec![(Triangle::new(glam::Vec3::X, glam::Vec3::Y, glam::Vec3::Z * 9.5), 1)];
+        let asked_again = || TriangleSet::shared(&sources, plain).list.clone();
+        let set = TriangleSet::shared(&sources, asked_again);
+        assert_eq!(set.list.len(), 1);
+        // Its building over, the thread finds the set again
+        assert!(Arc::ptr_eq(&set, &TriangleSet::shared(&sources, plain)));
     }
 }
