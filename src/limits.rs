@@ -104,6 +104,10 @@ pub const TEXT_FILE_BYTES: u64 = 16 << 20;
 pub const MESH_FILE_BYTES: u64 = 256 << 20;
 /// Triangles in one scene's meshes, all told.
 pub const MESH_TRIANGLES: usize = 10_000_000;
+/// Triangles a scene places, its meshes counted once a placement: each
+/// placed triangle is compiled into the world (a mesh placed a thousand
+/// times would otherwise ask for a thousand copies).
+pub const PLACED_TRIANGLES: usize = 20_000_000;
 /// The reference cache's size; the least recently used go beyond it.
 pub const REFERENCE_CACHE_BYTES: u64 = 512 << 20;
 

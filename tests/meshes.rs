@@ -443,3 +443,45 @@ fn a_finely_tessellated_sphere_renders_as_the_sphere() {
     assert!((mesh / analytic - 1.0).abs() < 0.001, "tessellated {mesh} against analytic {analytic}");
     assert!((without / analytic - 1.0).abs() > 0.02, "the ball barely shows: {without} against {analytic}");
 }
+
+/// A mesh placed over and over is refused once the triangles placed pass
+/// `limits::PLACED_TRIANGLES`, at the placement that passes it (each
+/// placement is compiled into the world: a thousand copies of a large mesh
+/// asked for gigabytes), and the scene file names that object's line.
+#[test]
+fn placements_past_the_limit_are_refused_at_the_one_that_passes_it() {
+    let mut scene = gi_studio::scene::presets::preset("knot").unwrap().unwrap().into_scene();
+    let knot = scene.objects.iter().position(|o| o.name == "torus knot").expect("the knot");
+    for k in 1..600 {
+        let mut copy = scene.objects[knot].clone();
+        copy.name = format!("knot {k}");
+        scene.objects.push(copy);
+    }
+    // The object whose placement first passes the limit, counted here
+    let mut placed = 0;
+    let passing = (scene.objects.iter().position(|o| {
+        if let Shape::Mesh { file, .. } = &o.shape {
+            placed += scene.meshes.get(file).expect("loaded").triangles.len();
+        }
+        placed > gi_studio::limits::PLACED_TRIANGLES
+    }))
+    .expect("600 knots pass the limit");
+    let problems = ValidScene::new(scene.clone()).expect_err("too many placed");
+    let found: Vec<_> = problems.iter().filter(|p| matches!(p.problem, Problem::TooManyPlaced { .. })).collect();
+    assert_eq!(found.len(), 1, "{problems:?}");
+    assert_eq!(found[0].item.as_deref(), Some(scene.objects[passing].name.as_str()));
+    let text = to_ron(&scene).expect("RON");
+    match gi_studio::scene::parse_scene(&text, Path::new("copies.ron")) {
+        Err(SceneFileError::Invalid { line, .. }) => {
+            // Its `file:` line, in its own item
+            let name = format!("\"{}\"", scene.objects[passing].name);
+            let item = 1 + text.lines().position(|l| l.contains(&name)).unwrap();
+            let file = item + text.lines().skip(item).position(|l| l.contains("file:")).unwrap() + 1;
+            assert_eq!(line, file);
+        }
+        other => panic!("{other:?}"),
+    }
+    // Up to the one before it, the scene is valid
+    scene.objects.truncate(passing);
+    assert!(ValidScene::new(scene).is_ok());
+}

@@ -53,6 +53,11 @@ pub enum Problem {
     EmptyName,
     #[error("the mesh file \"{0}\" is not loaded (open the scene from its file, beside the mesh)")]
     MeshNotLoaded(String),
+    #[error(
+        "with the meshes placed before it, {placed} triangles, more than the {} a scene may place",
+        limits::PLACED_TRIANGLES
+    )]
+    TooManyPlaced { placed: usize },
     #[error("{width} × {height} is more than the {} pixels an image may have", limits::IMAGE_PIXELS)]
     TooManyPixels { width: u32, height: u32 },
 }
@@ -225,6 +230,7 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
     }
 
     let mut names = HashSet::new();
+    let mut placed = 0usize;
     for (i, object) in scene.objects.iter().enumerate() {
         check.at("objects", Some(i), Some(&object.name), "");
         check.name(&mut names, &object.name);
@@ -248,8 +254,16 @@ pub(super) fn validate(scene: &Scene) -> Vec<Invalid> {
                 check.vector("c", *c);
             }
             Shape::Mesh { file, translate, scale, rotate_degrees } => {
-                if scene.meshes.get(file).is_none() {
-                    check.report("file", Problem::MeshNotLoaded(shown_name(file)));
+                match scene.meshes.get(file) {
+                    None => check.report("file", Problem::MeshNotLoaded(shown_name(file))),
+                    Some(mesh) => {
+                        // Reported once, at the placement that crosses the limit
+                        let before = placed;
+                        placed = placed.saturating_add(mesh.triangles.len());
+                        if placed > limits::PLACED_TRIANGLES && before <= limits::PLACED_TRIANGLES {
+                            check.report("file", Problem::TooManyPlaced { placed });
+                        }
+                    }
                 }
                 check.vector("translate", *translate);
                 check.positive("scale", *scale);
