@@ -51,12 +51,8 @@ fn blob(rings: u32) -> Vec<[Vec3; 3]> {
     triangles
 }
 
-/// Nearest hits of rays from a sphere of radius 3 aimed into a ball of
-/// radius 0.9 about a mesh of a quarter of a million triangles, one
-/// thread, through the world's hierarchy: against Embree's, same mesh and
-/// rays, by `benches/embree_mesh.py`.
-fn mesh_rays(c: &mut Criterion) {
-    use gi_studio::render::world::World;
+/// The thesis preset's camera and materials with the blob of `rings` alone.
+fn blob_scene(rings: u32) -> gi_studio::scene::ValidScene {
     use gi_studio::scene::mesh::MeshData;
     use gi_studio::scene::{Object, Shape, ValidScene};
     let mut scene = presets::preset("thesis").unwrap().unwrap().into_scene();
@@ -65,8 +61,17 @@ fn mesh_rays(c: &mut Criterion) {
         shape: Shape::Mesh { file: "blob".into(), translate: Vec3::ZERO, scale: 1.0, rotate_degrees: Vec3::ZERO },
         material: scene.materials[0].name.clone(),
     }];
-    scene.meshes.insert("blob".into(), Arc::new(MeshData::new(blob(256))));
-    let world = World::new(&ValidScene::new(scene).expect("the blob's scene"));
+    scene.meshes.insert("blob".into(), Arc::new(MeshData::new(blob(rings))));
+    ValidScene::new(scene).expect("the blob's scene")
+}
+
+/// Nearest hits of rays from a sphere of radius 3 aimed into a ball of
+/// radius 0.9 about a mesh of a quarter of a million triangles, one
+/// thread, through the world's hierarchy: against Embree's, same mesh and
+/// rays, by `benches/embree_mesh.py`.
+fn mesh_rays(c: &mut Criterion) {
+    use gi_studio::render::world::World;
+    let world = World::new(&blob_scene(256));
     let mut s = Sampler::new(0, 0, 3);
     let rays: Vec<Ray> = (0..100_000)
         .map(|_| {
@@ -90,8 +95,6 @@ fn mesh_rays(c: &mut Criterion) {
 /// world of a million triangles (the blob of `rings` 512), built.
 fn world_builds(c: &mut Criterion) {
     use gi_studio::render::world::World;
-    use gi_studio::scene::mesh::MeshData;
-    use gi_studio::scene::{Object, Shape, ValidScene};
     let knot = presets::preset("knot").unwrap().unwrap();
     let mut group = c.benchmark_group("world");
     group.sample_size(10);
@@ -99,14 +102,7 @@ fn world_builds(c: &mut Criterion) {
     let held = World::new(&knot);
     group.bench_function("knot_shared", |b| b.iter(|| World::new(black_box(&knot)).lights.len()));
     drop(held);
-    let mut scene = presets::preset("thesis").unwrap().unwrap().into_scene();
-    scene.objects = vec![Object {
-        name: "blob".into(),
-        shape: Shape::Mesh { file: "blob".into(), translate: Vec3::ZERO, scale: 1.0, rotate_degrees: Vec3::ZERO },
-        material: scene.materials[0].name.clone(),
-    }];
-    scene.meshes.insert("blob".into(), Arc::new(MeshData::new(blob(512))));
-    let million = ValidScene::new(scene).expect("the blob's scene");
+    let million = blob_scene(512);
     group.bench_function("blob_1m_triangles_built", |b| b.iter(|| World::new(black_box(&million)).lights.len()));
     group.finish();
 }
