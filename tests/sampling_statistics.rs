@@ -327,8 +327,12 @@ fn glass_ball_under(
     center: Vec3,
     radius: f32,
     light: gi_studio::scene::Light,
-) -> (World, gi_studio::render::integrators::photon_map::emit::LightPicker, Vec<(Vec3, f32)>) {
-    use gi_studio::render::integrators::photon_map::emit::{specular_targets, LightPicker};
+) -> (
+    World,
+    gi_studio::render::integrators::photon_map::emit::LightPicker,
+    gi_studio::render::integrators::photon_map::emit::SpecularTargets,
+) {
+    use gi_studio::render::integrators::photon_map::emit::{LightPicker, SpecularTargets};
     let objects = vec![
         object("floor", Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y }, "floor"),
         object("ball", Shape::Sphere { center, radius }, "glass"),
@@ -337,8 +341,8 @@ fn glass_ball_under(
     let materials = vec![material("floor", lambert(0.5)), material("glass", glass)];
     let eye = camera(Vec3::new(0.0, 1.0, 4.0), Vec3::ZERO);
     let world = World::new(&valid(scene(eye, materials, objects, vec![light])));
-    let (picker, targets) = (LightPicker::new(&world), specular_targets(&world));
-    assert_eq!(targets.len(), 1, "the ball is the one caustic target");
+    let (picker, targets) = (LightPicker::new(&world), SpecularTargets::of(&world));
+    assert_eq!(targets.list.len(), 1, "the ball is the one caustic target");
     (world, picker, targets)
 }
 

@@ -12,6 +12,7 @@ use crate::geometry::{Frame, Ray};
 use crate::render::world::light::Aim;
 use crate::render::world::rng::Sampler;
 use crate::render::world::sampling::{concentric_disk, uniform_cone, uniform_cone_pdf};
+use crate::render::world::shapes::bvh::Bvh;
 use crate::render::world::World;
 use crate::scene::Rgb;
 
@@ -83,9 +84,76 @@ pub fn emit(world: &World, picker: &LightPicker, sampler: &mut Sampler) -> Optio
     Some(EmittedPhoton { ray: emission.ray, power: emission.power / pick })
 }
 
-/// Bounding spheres of the specular objects, the targets of caustic photons
-/// (Jensen's projection maps, in their simplest form).
-pub fn specular_targets(world: &World) -> Vec<(Vec3, f32)> {
+/// The targets of caustic photons: the specular objects' bounding spheres
+/// (Jensen's projection maps, in their simplest form), and over many of
+/// them a hierarchy, so that a photon's density, summed over every target
+/// its line passes, costs the targets near the line rather than all.
+#[derive(Clone, Debug, Default)]
+pub struct SpecularTargets {
+    pub list: Vec<(Vec3, f32)>,
+    tree: Option<Bvh>,
+    /// A ball about every target's box: (centre, radius).
+    ball: (Vec3, f32),
+}
+
+/// From how many targets their hierarchy finds those on a line.
+const TARGET_TREE: usize = 16;
+
+/// How much wider a target's box is than its sphere: a direction the
+/// cone test takes by rounding, a hair outside the sphere, stays inside.
+const TARGET_SLACK: f32 = 1e-3;
+
+impl SpecularTargets {
+    pub fn of(world: &World) -> Self {
+        Self::new(specular_targets(world))
+    }
+
+    fn new(list: Vec<(Vec3, f32)>) -> Self {
+        let boxes: Vec<(Vec3, Vec3)> = (list.iter())
+            .map(|&(center, radius)| {
+                let reach = radius * (1.0 + TARGET_SLACK) + center.abs().max_element() * TARGET_SLACK;
+                (center - reach, center + reach)
+            })
+            .collect();
+        let tree = (list.len() > TARGET_TREE).then(|| Bvh::new(&boxes, 1));
+        let (lo, hi) =
+            boxes.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), b| (lo.min(b.0), hi.max(b.1)));
+        let ball = if lo.x <= hi.x { ((lo + hi) * 0.5, (hi - lo).length() * 0.5) } else { (Vec3::ZERO, 0.0) };
+        SpecularTargets { list, tree, ball }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
+    /// Each target the ray from `origin` along `direction` may pass (all of
+    /// them, or those whose boxes it enters), in the list's order: a sum
+    /// over them adds what a sum over the whole list adds, in the same order.
+    #[inline]
+    fn on_ray(&self, origin: Vec3, direction: Vec3, mut visit: impl FnMut(&(Vec3, f32))) {
+        let Some(tree) = &self.tree else {
+            return self.list.iter().for_each(visit);
+        };
+        let mut found = Vec::new();
+        tree.any_hit(&Ray::new(origin, direction), f32::INFINITY, |i| {
+            found.push(i);
+            false
+        });
+        found.sort_unstable();
+        found.iter().for_each(|&i| visit(&self.list[i as usize]));
+    }
+
+    /// `on_ray` for the whole line through `point` along `direction`: the
+    /// ray started behind every target.
+    #[inline]
+    fn on_line(&self, point: Vec3, direction: Vec3, visit: impl FnMut(&(Vec3, f32))) {
+        let back = (point - self.ball.0).length() + self.ball.1;
+        self.on_ray(point - direction * back, direction, visit)
+    }
+}
+
+/// Bounding spheres of the specular objects.
+fn specular_targets(world: &World) -> Vec<(Vec3, f32)> {
     world
         .objects
         .iter()
@@ -102,7 +170,7 @@ pub fn specular_targets(world: &World) -> Vec<(Vec3, f32)> {
 pub fn emit_toward(
     world: &World,
     picker: &LightPicker,
-    targets: &[(Vec3, f32)],
+    targets: &SpecularTargets,
     sampler: &mut Sampler,
 ) -> Option<EmittedPhoton> {
     if targets.is_empty() {
@@ -110,10 +178,10 @@ pub fn emit_toward(
     }
     let (index, pick) = picker.pick(sampler.next_f32())?;
     let light = &world.lights[index];
-    let target = targets[((sampler.next_f32() * targets.len() as f32) as usize).min(targets.len() - 1)];
+    let count = targets.list.len();
+    let target = targets.list[((sampler.next_f32() * count as f32) as usize).min(count - 1)];
     let (u1, u2) = (sampler.next_2d(), sampler.next_2d());
-    let aim =
-        Targets { targets, target, target_pick: 1.0 / targets.len() as f32, u1, u2, scene_radius: world.bounds_radius };
+    let aim = Targets { targets, target, target_pick: 1.0 / count as f32, u1, u2, scene_radius: world.bounds_radius };
     let (ray, power) = light.emit_toward(&aim, u1, u2)?;
     power.is_finite().then_some(EmittedPhoton { ray, power: power / pick })
 }
@@ -121,7 +189,7 @@ pub fn emit_toward(
 /// Caustic photons' aim: a target drawn among `targets` (bounding
 /// spheres), and the density of a direction or a start over all of them.
 struct Targets<'t> {
-    targets: &'t [(Vec3, f32)],
+    targets: &'t SpecularTargets,
     /// The target drawn, with probability `target_pick`.
     target: (Vec3, f32),
     target_pick: f32,
@@ -148,19 +216,21 @@ impl Aim for Targets<'_> {
     /// Over every target whose cone holds `direction`, so overlapping
     /// targets are not counted twice.
     fn direction_pdf(&self, origin: Vec3, direction: Vec3) -> f32 {
-        (self.targets.iter())
-            .filter_map(|(center, radius)| {
-                let to = *center - origin;
-                let distance2 = to.length_squared();
-                let sin2 = radius * radius / distance2;
-                if sin2 >= 1.0 {
-                    return None;
-                }
-                let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
-                let cos = to.dot(direction) / distance2.sqrt();
-                (cos >= 1.0 - one_minus_cos).then(|| uniform_cone_pdf(one_minus_cos) * self.target_pick)
-            })
-            .sum()
+        let mut pdf = 0.0;
+        self.targets.on_ray(origin, direction, |(center, radius)| {
+            let to = *center - origin;
+            let distance2 = to.length_squared();
+            let sin2 = radius * radius / distance2;
+            if sin2 >= 1.0 {
+                return;
+            }
+            let one_minus_cos = sin2 / (1.0 + (1.0 - sin2).sqrt());
+            let cos = to.dot(direction) / distance2.sqrt();
+            if cos >= 1.0 - one_minus_cos {
+                pdf += uniform_cone_pdf(one_minus_cos) * self.target_pick;
+            }
+        });
+        pdf
     }
 
     /// On a disc just covering the drawn target across `direction`,
@@ -171,13 +241,13 @@ impl Aim for Targets<'_> {
         let frame = Frame::from_z(direction);
         let disc = concentric_disk(self.u1) * radius;
         let origin = center - direction * (2.0 * self.scene_radius.max(radius)) + frame.x * disc.x + frame.y * disc.y;
-        let density = (self.targets.iter())
-            .filter(|(c, r)| {
-                let offset = *c - origin;
-                (offset - direction * offset.dot(direction)).length_squared() <= r * r
-            })
-            .map(|(_, r)| self.target_pick / (PI * r * r))
-            .sum();
+        let mut density = 0.0;
+        self.targets.on_line(origin, direction, |(c, r)| {
+            let offset = *c - origin;
+            if (offset - direction * offset.dot(direction)).length_squared() <= r * r {
+                density += self.target_pick / (PI * r * r);
+            }
+        });
         (origin, density)
     }
 }
@@ -250,7 +320,7 @@ mod tests {
         }
         // A caustic photon too: the same draws from the first twin carry
         // twice what they carry from it alone
-        let (targets, alone_picker) = (specular_targets(&world), LightPicker::new(&alone));
+        let (targets, alone_picker) = (SpecularTargets::of(&world), LightPicker::new(&alone));
         let mut twins = 0;
         for i in 0..100 {
             let (mut s, mut same) = (Sampler::new(i, 0, 2), Sampler::new(i, 0, 2));
@@ -327,14 +397,14 @@ mod tests {
                 _ => scene.background = Rgb::splat(sky),
             }
             let world = world(scene);
-            let (picker, targets) = (LightPicker::new(&world), specular_targets(&world));
-            assert_eq!((world.lights.len(), targets.len()), (1, 3), "{name}");
-            let share = 1.0 / targets.len() as f64;
+            let (picker, targets) = (LightPicker::new(&world), SpecularTargets::of(&world));
+            assert_eq!((world.lights.len(), targets.list.len()), (1, 3), "{name}");
+            let share = 1.0 / targets.list.len() as f64;
             // Solid-angle density of aiming `d` from `o`, and area density
             // of a line along `d` through `o` crossing the targets' discs
             let cones = |o: Vec3, d: Vec3| -> (f64, bool, usize) {
                 let (mut sum, mut on_edge, mut within) = (0.0, false, 0);
-                for (c, r) in &targets {
+                for (c, r) in &targets.list {
                     let to = (*c - o).as_dvec3();
                     let cos_max = (1.0 - (*r as f64 / to.length()).powi(2)).sqrt();
                     let cos = to.normalize().dot(d.as_dvec3());
@@ -348,7 +418,7 @@ mod tests {
             };
             let discs = |o: Vec3, d: Vec3| -> (f64, bool, usize) {
                 let (mut sum, mut on_edge, mut within) = (0.0, false, 0);
-                for (c, r) in &targets {
+                for (c, r) in &targets.list {
                     let to = (*c - o).as_dvec3();
                     let off_axis = (to - d.as_dvec3() * to.dot(d.as_dvec3())).length();
                     on_edge |= (off_axis / *r as f64 - 1.0).abs() < 1e-4;
@@ -421,8 +491,8 @@ mod tests {
                 None => scene.background = Rgb::ONE,
             }
             let world = world(scene);
-            let (picker, targets) = (LightPicker::new(&world), specular_targets(&world));
-            let [(center, radius)] = targets[..] else { panic!("{targets:?}") };
+            let (picker, targets) = (LightPicker::new(&world), SpecularTargets::of(&world));
+            let [(center, radius)] = targets.list[..] else { panic!("{targets:?}") };
             let mut s = Sampler::new(0, 0, 3);
             // A line grazing the disc's rim can be lost to rounding (no density, no photon)
             let samples: Vec<f64> = (0..20_000)
@@ -451,5 +521,44 @@ mod tests {
             let standard_error = (samples.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
             assert!((mean - 0.5).abs() < 5.0 * standard_error, "{name}: mean {mean} ± {standard_error}");
         }
+    }
+
+    /// Over many targets, the hierarchy finds every target a photon's ray
+    /// or line passes: the densities equal the sums over the whole list,
+    /// bit for bit, for photons aimed at the targets and for any other.
+    #[test]
+    fn many_targets_give_the_densities_of_all_of_them() {
+        use crate::render::world::sampling::uniform_sphere;
+        let mut s = Sampler::new(0, 0, 71);
+        let list: Vec<(Vec3, f32)> =
+            (0..300).map(|_| (uniform_sphere(s.next_2d()) * 6.0 * s.next_f32(), 0.05 + 0.4 * s.next_f32())).collect();
+        let with_tree = SpecularTargets::new(list.clone());
+        assert!(with_tree.tree.is_some());
+        let without = SpecularTargets { tree: None, ..with_tree.clone() };
+        let (mut passed, mut on_lines) = (0, 0);
+        for k in 0..20_000 {
+            let target = list[k % list.len()];
+            let (u1, u2) = (s.next_2d(), s.next_2d());
+            let aim = |targets| Targets { targets, target, target_pick: 1.0 / 300.0, u1, u2, scene_radius: 10.0 };
+            let (tree, all) = (aim(&with_tree), aim(&without));
+            let origin = uniform_sphere(s.next_2d()) * 9.0;
+            // Half aimed at the drawn target's sphere (its edge too), half anywhere
+            let direction = match k % 2 {
+                0 => (target.0 + uniform_sphere(s.next_2d()) * target.1 * 1.05 - origin).normalize(),
+                _ => uniform_sphere(s.next_2d()),
+            };
+            let pdf = all.direction_pdf(origin, direction);
+            assert_eq!(tree.direction_pdf(origin, direction).to_bits(), pdf.to_bits(), "photon {k}");
+            passed += (pdf > 0.0) as u32;
+            let ((start, density), (tree_start, tree_density)) = (all.upstream(direction), tree.upstream(direction));
+            assert_eq!((tree_start, tree_density.to_bits()), (start, density.to_bits()), "photon {k}");
+            on_lines += (density > target_pick_of(&all)) as u32;
+        }
+        // Most aimed photons pass their target, and many lines pass several
+        assert!(passed > 8_000 && on_lines > 2_000, "{passed} photons passed targets, {on_lines} lines several");
+    }
+
+    fn target_pick_of(targets: &Targets) -> f32 {
+        targets.target_pick / (PI * targets.target.1 * targets.target.1)
     }
 }

@@ -5,9 +5,7 @@
 //! these two one at a time (`flying`), and `flight_lanes` eight at a time
 //! as these two do.
 
-use glam::Vec3;
-
-use super::emit::{emit, emit_toward, specular_targets, EmittedPhoton, LightPicker};
+use super::emit::{emit, emit_toward, EmittedPhoton, LightPicker, SpecularTargets};
 use super::record::Photon;
 use crate::faults::{self, Fault};
 use crate::geometry::Ray;
@@ -53,7 +51,7 @@ pub(super) struct Tracing<'a> {
     kind: MapKind,
     picker: LightPicker,
     /// Balls bounding the mirrors and glass (caustic maps only).
-    targets: Vec<(Vec3, f32)>,
+    targets: SpecularTargets,
     /// 1 / the photon count: each stored power's share.
     scale: f32,
     /// The most segments a photon flies: a path's, less the camera's one
@@ -88,7 +86,7 @@ impl<'a> Tracing<'a> {
         if picker.is_empty() || count == 0 {
             return None;
         }
-        let targets = if kind == MapKind::Caustic { specular_targets(world) } else { Vec::new() };
+        let targets = if kind == MapKind::Caustic { SpecularTargets::of(world) } else { SpecularTargets::default() };
         if kind == MapKind::Caustic && targets.is_empty() {
             return None;
         }
