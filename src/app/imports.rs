@@ -41,7 +41,7 @@ impl Imports {
             // No thread to be had: read it here, as before
             Err(_) => {
                 let (send, receive) = mpsc::channel();
-                let _ = send.send(load_mesh(&path));
+                let _ = send.send(read(&path));
                 self.reading.push((path, receive));
             }
         }

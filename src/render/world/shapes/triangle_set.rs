@@ -111,8 +111,8 @@ impl Drop for Building {
 }
 
 impl TriangleSet {
-    /// The set of `list` (the triangles `sources` make), with their planes
-    /// shared where they lie in one.
+    /// The set of `list`, its triangles' planes shared where they lie in
+    /// one, grouped or under a hierarchy by their number.
     pub fn new(mut list: Vec<(Triangle, u32)>) -> Self {
         Triangle::share_planes(&mut list.iter_mut().map(|(triangle, _)| triangle).collect::<Vec<_>>());
         match list.len() > GROUPED_TRIANGLES {
